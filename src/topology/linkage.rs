@@ -1,0 +1,1 @@
+//! Placeholder until the topology engine lands (issue #3).
