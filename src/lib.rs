@@ -13,6 +13,7 @@
 //! | simulation | [`sim`] | [`world::World`], seed | [`log::EncounterLog`] |
 //! | topology engine | [`topology`] | point clouds, distance matrices | diagrams, dendrograms, embeddings |
 
+pub mod eval;
 pub mod io;
 pub mod log;
 pub mod sim;

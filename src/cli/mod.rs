@@ -25,7 +25,11 @@ pub fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
 }
 
 #[derive(Parser)]
-#[command(name = "swarmmap", version, about = "Topological maps from the encounters of a robot swarm")]
+#[command(
+    name = "swarmmap",
+    version,
+    about = "Topological maps from the encounters of a robot swarm"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -43,10 +43,7 @@ impl PointCloud {
         for r in rows {
             let r = r.as_ref();
             if r.len() != dim {
-                return Err(MatrixError::Ragged {
-                    len: r.len(),
-                    dim,
-                });
+                return Err(MatrixError::Ragged { len: r.len(), dim });
             }
             coords.extend_from_slice(r);
         }
@@ -135,7 +132,11 @@ impl DistanceMatrix {
             for j in i + 1..n {
                 let v = m.get(i, j);
                 if !v.is_finite() || v < 0.0 {
-                    return Err(MatrixError::BadEntry { row: i, col: j, value: v });
+                    return Err(MatrixError::BadEntry {
+                        row: i,
+                        col: j,
+                        value: v,
+                    });
                 }
             }
         }
@@ -149,14 +150,25 @@ impl DistanceMatrix {
         for (i, r) in rows.iter().enumerate() {
             let r = r.as_ref();
             if r.len() != n {
-                return Err(MatrixError::NotSquare { row: i, len: r.len(), n });
+                return Err(MatrixError::NotSquare {
+                    row: i,
+                    len: r.len(),
+                    n,
+                });
             }
             if r[i] != 0.0 {
-                return Err(MatrixError::Diagonal { row: i, value: r[i] });
+                return Err(MatrixError::Diagonal {
+                    row: i,
+                    value: r[i],
+                });
             }
             for (j, &v) in r.iter().enumerate() {
                 if !v.is_finite() || v < 0.0 {
-                    return Err(MatrixError::BadEntry { row: i, col: j, value: v });
+                    return Err(MatrixError::BadEntry {
+                        row: i,
+                        col: j,
+                        value: v,
+                    });
                 }
             }
         }
@@ -164,7 +176,12 @@ impl DistanceMatrix {
             for j in i + 1..n {
                 let (a, b) = (rows[i].as_ref()[j], rows[j].as_ref()[i]);
                 if (a - b).abs() > 1e-9 * a.abs().max(b.abs()).max(f64::MIN_POSITIVE) {
-                    return Err(MatrixError::Asymmetric { row: i, col: j, a, b });
+                    return Err(MatrixError::Asymmetric {
+                        row: i,
+                        col: j,
+                        a,
+                        b,
+                    });
                 }
             }
         }
@@ -201,7 +218,11 @@ impl DistanceMatrix {
     /// Sets the distance between `i ≠ j`.
     #[inline]
     pub fn set(&mut self, i: usize, j: usize, v: f64) {
-        let k = if i < j { self.index(i, j) } else { self.index(j, i) };
+        let k = if i < j {
+            self.index(i, j)
+        } else {
+            self.index(j, i)
+        };
         self.data[k] = v;
     }
 
@@ -221,20 +242,31 @@ impl DistanceMatrix {
 pub enum MatrixError {
     #[error("points must have at least one coordinate")]
     ZeroDimension,
-    #[error("{len} coordinates do not split into points of dimension {dim}; every row needs the same number of columns")]
+    #[error(
+        "{len} coordinates do not split into points of dimension {dim}; every row needs the same number of columns"
+    )]
     Ragged { len: usize, dim: usize },
     #[error("coordinate {col} of point {row} is not a finite number")]
     NonFinite { row: usize, col: usize },
     #[error("a condensed matrix for this many points needs {want} entries, got {len}")]
     CondensedLength { len: usize, want: usize },
-    #[error("row {row} has {len} entries but the matrix has {n} rows; a distance matrix must be square")]
+    #[error(
+        "row {row} has {len} entries but the matrix has {n} rows; a distance matrix must be square"
+    )]
     NotSquare { row: usize, len: usize, n: usize },
     #[error("diagonal entry ({row}, {row}) is {value}; a point is at distance 0 from itself")]
     Diagonal { row: usize, value: f64 },
     #[error("entry ({row}, {col}) is {value}; distances must be finite and non-negative")]
     BadEntry { row: usize, col: usize, value: f64 },
-    #[error("entries ({row}, {col}) = {a} and ({col}, {row}) = {b} differ; a distance matrix must be symmetric")]
-    Asymmetric { row: usize, col: usize, a: f64, b: f64 },
+    #[error(
+        "entries ({row}, {col}) = {a} and ({col}, {row}) = {b} differ; a distance matrix must be symmetric"
+    )]
+    Asymmetric {
+        row: usize,
+        col: usize,
+        a: f64,
+        b: f64,
+    },
 }
 
 #[cfg(test)]

@@ -24,7 +24,11 @@ pub enum Obstacle {
     /// Simple polygon (possibly non-convex), vertices in order.
     Polygon { points: Vec<Vec2> },
     /// Thick segment: the set of points within `thickness / 2` of the segment.
-    Wall { from: Vec2, to: Vec2, thickness: f64 },
+    Wall {
+        from: Vec2,
+        to: Vec2,
+        thickness: f64,
+    },
 }
 
 /// How agents are placed at `t = 0`.
@@ -199,7 +203,11 @@ impl World {
     pub fn leader_x(&self, t: f64) -> f64 {
         let s = (t - self.simulation.dispersion_time).max(0.0) * self.leader.speed;
         let (a, b) = (self.leader.start_x, self.leader.end_x);
-        if b >= a { (a + s).min(b) } else { (a - s).max(b) }
+        if b >= a {
+            (a + s).min(b)
+        } else {
+            (a - s).max(b)
+        }
     }
 
     /// The domain D(t) as `(x_min, x_max)`, clipped to the arena; it spans the full height.

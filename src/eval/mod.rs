@@ -1,0 +1,1 @@
+//! Evaluation against ground truth (issue #4 §4).
