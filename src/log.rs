@@ -5,6 +5,10 @@
 //! coordinate-free columns; the ground-truth columns (true positions at the start of an
 //! encounter) are optional and read only by evaluation.
 
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
 /// Agent identifier (index into the swarm).
 pub type AgentId = u32;
 
@@ -56,4 +60,391 @@ pub struct EncounterLog {
     pub encounters: Vec<Encounter>,
     pub static_intervals: Vec<StaticInterval>,
     pub leader: Vec<(f64, f64)>,
+}
+
+/// File names of a run directory (see the README, "Output files").
+pub const ENCOUNTERS_CSV: &str = "encounters.csv";
+/// Static intervals of landmarks and pauses.
+pub const STATIC_CSV: &str = "static_intervals.csv";
+/// The leader's track.
+pub const LEADER_CSV: &str = "leader.csv";
+
+/// What is wrong with a log, and where.
+#[derive(Debug, Error)]
+pub enum LogError {
+    /// A file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A required file is missing.
+    #[error("{path}: file not found; a log directory needs {what}")]
+    Missing { path: PathBuf, what: &'static str },
+    /// A problem at a line of a CSV file.
+    #[error("{path}:{line}: {message}")]
+    Csv {
+        path: PathBuf,
+        line: u64,
+        message: String,
+    },
+}
+
+struct Columns {
+    index: HashMap<String, usize>,
+}
+
+impl Columns {
+    fn get(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+}
+
+/// A CSV reader that reports every problem with its file and line.
+struct CsvFile {
+    path: PathBuf,
+    reader: csv::Reader<std::fs::File>,
+    columns: Columns,
+}
+
+impl CsvFile {
+    fn open(path: &Path, required: &[&str]) -> Result<Self, LogError> {
+        let file = std::fs::File::open(path).map_err(|source| LogError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(file);
+        let headers = reader
+            .headers()
+            .map_err(|e| csv_error(path, 1, &e))?
+            .clone();
+        let index: HashMap<String, usize> = headers
+            .iter()
+            .enumerate()
+            .map(|(i, h)| (h.to_string(), i))
+            .collect();
+        for r in required {
+            if !index.contains_key(*r) {
+                return Err(LogError::Csv {
+                    path: path.to_path_buf(),
+                    line: 1,
+                    message: format!(
+                        "missing column `{r}`; the header must contain {} (found: {})",
+                        required.join(","),
+                        headers.iter().collect::<Vec<_>>().join(",")
+                    ),
+                });
+            }
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader,
+            columns: Columns { index },
+        })
+    }
+
+    /// Visits every record with its 1-based line number.
+    fn for_each(
+        &mut self,
+        mut f: impl FnMut(&Row<'_>) -> Result<(), String>,
+    ) -> Result<(), LogError> {
+        let mut record = csv::StringRecord::new();
+        loop {
+            let line = self.reader.position().line();
+            match self.reader.read_record(&mut record) {
+                Ok(false) => return Ok(()),
+                Ok(true) => {
+                    let line = record.position().map(|p| p.line()).unwrap_or(line);
+                    let row = Row {
+                        record: &record,
+                        columns: &self.columns,
+                    };
+                    f(&row).map_err(|message| LogError::Csv {
+                        path: self.path.clone(),
+                        line,
+                        message,
+                    })?;
+                }
+                Err(e) => return Err(csv_error(&self.path, line, &e)),
+            }
+        }
+    }
+}
+
+fn csv_error(path: &Path, line: u64, e: &csv::Error) -> LogError {
+    let line = e.position().map(|p| p.line()).unwrap_or(line);
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!(
+            "this row has {len} fields but the header has {expected_len}; every row needs one value per column"
+        ),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+        _ => e.to_string(),
+    };
+    LogError::Csv {
+        path: path.to_path_buf(),
+        line,
+        message,
+    }
+}
+
+struct Row<'a> {
+    record: &'a csv::StringRecord,
+    columns: &'a Columns,
+}
+
+impl Row<'_> {
+    fn text(&self, name: &str) -> Option<&str> {
+        self.columns.get(name).and_then(|i| self.record.get(i))
+    }
+
+    fn f64(&self, name: &str) -> Result<f64, String> {
+        let s = self.text(name).unwrap_or("");
+        let v: f64 = s
+            .parse()
+            .map_err(|_| format!("column `{name}` is `{s}`, which is not a number"))?;
+        if !v.is_finite() {
+            return Err(format!(
+                "column `{name}` is `{s}`; times and positions must be finite numbers"
+            ));
+        }
+        Ok(v)
+    }
+
+    fn agent(&self, name: &str) -> Result<AgentId, String> {
+        let s = self.text(name).unwrap_or("");
+        s.parse()
+            .map_err(|_| format!("column `{name}` is `{s}`; agent ids are non-negative integers"))
+    }
+}
+
+impl EncounterLog {
+    /// Reads a log directory: `encounters.csv` (required), `static_intervals.csv`
+    /// (optional: without it no time is bridged by static agents) and `leader.csv`
+    /// (optional). Truth columns `a_x,a_y,b_x,b_y` are read when all four are present.
+    pub fn read_dir(dir: &Path) -> Result<Self, LogError> {
+        let enc_path = dir.join(ENCOUNTERS_CSV);
+        if !enc_path.exists() {
+            return Err(LogError::Missing {
+                path: enc_path,
+                what: "encounters.csv with columns start,end,a,b",
+            });
+        }
+        let mut log = EncounterLog {
+            encounters: read_encounters(&enc_path)?,
+            ..Default::default()
+        };
+        let st = dir.join(STATIC_CSV);
+        if st.exists() {
+            log.static_intervals = read_static(&st)?;
+        }
+        let le = dir.join(LEADER_CSV);
+        if le.exists() {
+            log.leader = read_leader(&le)?;
+        }
+        Ok(log)
+    }
+
+    /// Whether every encounter carries ground-truth positions.
+    pub fn has_truth(&self) -> bool {
+        !self.encounters.is_empty() && self.encounters.iter().all(|e| e.truth.is_some())
+    }
+
+    /// The time span `[min start, max end]` of the encounters and static intervals.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        let times = self
+            .encounters
+            .iter()
+            .map(|e| (e.start, e.end))
+            .chain(self.static_intervals.iter().map(|s| (s.start, s.end)));
+        times.fold(None, |acc, (a, b)| match acc {
+            None => Some((a, b)),
+            Some((lo, hi)) => Some((f64::min(lo, a), f64::max(hi, b))),
+        })
+    }
+}
+
+fn interval(row: &Row<'_>) -> Result<(f64, f64), String> {
+    let (start, end) = (row.f64("start")?, row.f64("end")?);
+    if end < start {
+        return Err(format!(
+            "end {end} is before start {start}; an interval must have end >= start"
+        ));
+    }
+    Ok((start, end))
+}
+
+fn read_encounters(path: &Path) -> Result<Vec<Encounter>, LogError> {
+    let mut f = CsvFile::open(path, &["start", "end", "a", "b"])?;
+    let truth_cols = ["a_x", "a_y", "b_x", "b_y"];
+    let with_truth = truth_cols.iter().all(|c| f.columns.get(c).is_some());
+    let mut out = Vec::new();
+    f.for_each(|row| {
+        let (start, end) = interval(row)?;
+        let (a, b) = (row.agent("a")?, row.agent("b")?);
+        if a == b {
+            return Err(format!(
+                "agent {a} meets itself; an encounter needs two different agents"
+            ));
+        }
+        let truth = if with_truth {
+            Some([
+                row.f64("a_x")?,
+                row.f64("a_y")?,
+                row.f64("b_x")?,
+                row.f64("b_y")?,
+            ])
+        } else {
+            None
+        };
+        // Normalise to a < b, swapping the truth columns with the ids.
+        let (a, b, truth) = if a < b {
+            (a, b, truth)
+        } else {
+            (b, a, truth.map(|t| [t[2], t[3], t[0], t[1]]))
+        };
+        out.push(Encounter {
+            start,
+            end,
+            a,
+            b,
+            truth,
+        });
+        Ok(())
+    })?;
+    out.sort_by(|x, y| {
+        x.start
+            .total_cmp(&y.start)
+            .then(x.a.cmp(&y.a))
+            .then(x.b.cmp(&y.b))
+    });
+    Ok(out)
+}
+
+fn read_static(path: &Path) -> Result<Vec<StaticInterval>, LogError> {
+    let mut f = CsvFile::open(path, &["agent", "start", "end"])?;
+    let has_reason = f.columns.get("reason").is_some();
+    let mut out = Vec::new();
+    f.for_each(|row| {
+        let (start, end) = interval(row)?;
+        let reason = match row.text("reason").filter(|_| has_reason) {
+            None | Some("landmark") => StaticReason::Landmark,
+            Some("pause") => StaticReason::Pause,
+            Some(other) => {
+                return Err(format!(
+                    "column `reason` is `{other}`; use `landmark` or `pause`"
+                ));
+            }
+        };
+        out.push(StaticInterval {
+            agent: row.agent("agent")?,
+            start,
+            end,
+            reason,
+        });
+        Ok(())
+    })?;
+    out.sort_by(|x, y| x.agent.cmp(&y.agent).then(x.start.total_cmp(&y.start)));
+    Ok(out)
+}
+
+fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
+    let mut f = CsvFile::open(path, &["time", "x"])?;
+    let mut out = Vec::new();
+    f.for_each(|row| {
+        out.push((row.f64("time")?, row.f64("x")?));
+        Ok(())
+    })?;
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir_with(files: &[(&str, &str)]) -> tempfile::TempDir {
+        let d = tempfile::tempdir().unwrap();
+        for (name, text) in files {
+            std::fs::write(d.path().join(name), text).unwrap();
+        }
+        d
+    }
+
+    #[test]
+    fn reads_a_log_without_truth() {
+        let d = dir_with(&[
+            (
+                "encounters.csv",
+                "start,end,a,b\n2.0,3.0,5,1\n1.0,1.5,0,1\n",
+            ),
+            (
+                "static_intervals.csv",
+                "agent,start,end,reason\n1,0,10,landmark\n2,4,5,pause\n",
+            ),
+        ]);
+        let log = EncounterLog::read_dir(d.path()).unwrap();
+        assert_eq!(log.encounters.len(), 2);
+        assert_eq!((log.encounters[0].a, log.encounters[0].b), (0, 1));
+        assert_eq!((log.encounters[1].a, log.encounters[1].b), (1, 5));
+        assert!(!log.has_truth());
+        assert_eq!(log.static_intervals[1].reason, StaticReason::Pause);
+        assert_eq!(log.span(), Some((0.0, 10.0)));
+    }
+
+    #[test]
+    fn swaps_truth_with_ids() {
+        let d = dir_with(&[(
+            "encounters.csv",
+            "start,end,a,b,a_x,a_y,b_x,b_y\n0,1,3,2,1,2,3,4\n",
+        )]);
+        let e = &EncounterLog::read_dir(d.path()).unwrap().encounters[0];
+        assert_eq!((e.a, e.b), (2, 3));
+        assert_eq!(e.truth, Some([3.0, 4.0, 1.0, 2.0]));
+    }
+
+    fn error_of(text: &str) -> String {
+        let d = dir_with(&[("encounters.csv", text)]);
+        EncounterLog::read_dir(d.path()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn errors_name_the_line_and_the_fix() {
+        let e = error_of("start,end,a,b\n0,1,0,1\n0,x,0,1\n");
+        assert!(
+            e.ends_with("encounters.csv:3: column `end` is `x`, which is not a number"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b\n5,1,0,1\n");
+        assert!(
+            e.contains("encounters.csv:2: end 1 is before start 5"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b\nNaN,1,0,1\n");
+        assert!(
+            e.contains(":2: column `start` is `NaN`; times and positions must be finite"),
+            "{e}"
+        );
+        let e = error_of("start,end,a\n0,1,0\n");
+        assert!(e.contains(":1: missing column `b`"), "{e}");
+        let e = error_of("start,end,a,b\n0,1,0,1\n0,1,0\n");
+        assert!(
+            e.contains(":3: this row has 3 fields but the header has 4"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b\n0,1,-1,1\n");
+        assert!(
+            e.contains(":2: column `a` is `-1`; agent ids are non-negative integers"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b\n0,1,4,4\n");
+        assert!(e.contains(":2: agent 4 meets itself"), "{e}");
+        let d = tempfile::tempdir().unwrap();
+        let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
+        assert!(e.contains("file not found"), "{e}");
+    }
 }
