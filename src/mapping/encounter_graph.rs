@@ -1,0 +1,412 @@
+//! The encounter graph and its shortest-path metric (paper §"Geometric Reconstruction",
+//! eq. for w_ij and the static-agent rule).
+//!
+//! The paper's graph has one vertex per encounter E_i and, for every pair sharing an agent,
+//! an edge of weight `w_ij = inf |t1 − t2|` over their time intervals, set to `0` when the
+//! shared agent `s` was static during an interval T^k(s) that meets both T(E_i) and T(E_j).
+//! Built literally that is a clique per agent: O(E²) edges.
+//!
+//! # The sparse graph, and why it has the same shortest paths
+//!
+//! Fix one agent and its encounters I_1, …, I_m sorted by start time. Let M_{k−1} be the
+//! encounter among I_1..I_{k−1} with the latest end. We join I_k to M_{k−1} only, with weight
+//! `max(0, s_k − e(M_{k−1}))`: a forest with m − 1 edges per agent.
+//!
+//! *Claim.* For intervals on a line with clique weights `gap(I, J)`, the shortest-path
+//! distance between I and J is the total *uncovered* time between them: the length of the
+//! part of the line between the two intervals that no interval of this agent covers.
+//! - Lower bound: a hop from I to J costs their whole gap, which contains every uncovered
+//!   point between them. A path from I to J must get past every uncovered point between
+//!   them, and only a hop whose gap contains the point gets past it; together the hops'
+//!   gaps cover the uncovered time, so the path costs at least that much.
+//! - Upper bound: walking from I to J through the intervals in start order, consecutive
+//!   overlapping intervals cost 0 and each crossing of an uncovered gap costs that gap.
+//!
+//! In the forest, an edge I_k → M_{k−1} has positive weight exactly when an uncovered gap
+//! `(e(M_{k−1}), s_k)` precedes I_k, and it charges exactly that gap; every maximal busy
+//! block of the time line is a zero-weight subtree and consecutive blocks are joined by one
+//! edge weighted by the gap between them. The tree path between I and J therefore crosses
+//! exactly the gaps between their blocks: the uncovered time. ∎ The test
+//! `sparse_equals_clique` checks this against the literal clique on random logs.
+//!
+//! The static rule adds, for each static interval V of agent s, a virtual vertex joined
+//! with weight 0 to every encounter of s whose interval meets V. Zero-weight stars and
+//! zero-weight cliques have the same shortest paths, so the union with the forest gives the
+//! paper's metric exactly, with O(E + Σ|encounters meeting V|) = O(E) edges.
+//!
+//! In [`Bridging::StaticTimeFree`] the static interval V also joins the agent's time line
+//! as an interval of its own: time spent static costs nothing, so an encounter shortly
+//! after a pause is close to the encounters during it (the agent had not moved). This is a
+//! tighter upper bound on travel time than the paper's rule; it is one of the improvements
+//! measured by `swarmmap eval`.
+
+use crate::log::{AgentId, Encounter, StaticInterval};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+
+/// How static intervals bridge time in the metric.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bridging {
+    /// The paper's rule: two encounters of `s` both meeting one static interval are at 0.
+    Paper,
+    /// The paper's rule, and static time itself is free along the agent's time line.
+    StaticTimeFree,
+}
+
+/// A weighted undirected graph in compressed sparse row form. Vertices `0..encounters`
+/// are encounters (in the order given); the rest are virtual static-interval vertices.
+#[derive(Debug, Clone)]
+pub struct EncounterGraph {
+    encounters: usize,
+    offsets: Vec<usize>,
+    targets: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+/// An interval on one agent's time line: an encounter vertex or a static vertex.
+#[derive(Clone, Copy)]
+struct Item {
+    start: f64,
+    end: f64,
+    vertex: u32,
+    /// Whether this item takes part in the time-line forest.
+    on_line: bool,
+}
+
+impl EncounterGraph {
+    /// Builds the sparse graph of `encounters` with the static intervals `statics`
+    /// (those that meet no encounter are ignored).
+    pub fn build(encounters: &[Encounter], statics: &[StaticInterval], bridging: Bridging) -> Self {
+        let n = encounters.len();
+        let mut lines: HashMap<AgentId, Vec<Item>> = HashMap::new();
+        for (i, e) in encounters.iter().enumerate() {
+            for agent in [e.a, e.b] {
+                lines.entry(agent).or_default().push(Item {
+                    start: e.start,
+                    end: e.end,
+                    vertex: i as u32,
+                    on_line: true,
+                });
+            }
+        }
+        let mut edges: Vec<(u32, u32, f64)> = Vec::with_capacity(2 * n);
+        let mut next_vertex = n as u32;
+        // Static intervals sorted by agent then start, so vertex numbering is deterministic.
+        let mut statics: Vec<&StaticInterval> = statics.iter().collect();
+        statics.sort_by(|x, y| x.agent.cmp(&y.agent).then(x.start.total_cmp(&y.start)));
+        for s in statics {
+            let Some(line) = lines.get_mut(&s.agent) else {
+                continue;
+            };
+            let members: Vec<u32> = line
+                .iter()
+                .filter(|it| it.on_line && it.vertex < n as u32)
+                .filter(|it| it.start <= s.end && s.start <= it.end)
+                .map(|it| it.vertex)
+                .collect();
+            let free_time = bridging == Bridging::StaticTimeFree;
+            if members.is_empty() && !free_time {
+                continue;
+            }
+            let v = next_vertex;
+            next_vertex += 1;
+            edges.extend(members.iter().map(|&m| (v, m, 0.0)));
+            line.push(Item {
+                start: s.start,
+                end: s.end,
+                vertex: v,
+                on_line: free_time,
+            });
+        }
+        let mut agents: Vec<_> = lines.into_iter().collect();
+        agents.sort_by_key(|(a, _)| *a);
+        for (_, mut line) in agents {
+            line.retain(|it| it.on_line);
+            line.sort_by(|x, y| x.start.total_cmp(&y.start).then(x.vertex.cmp(&y.vertex)));
+            let mut latest: Option<Item> = None;
+            for it in line {
+                if let Some(m) = latest {
+                    edges.push((it.vertex, m.vertex, (it.start - m.end).max(0.0)));
+                    if it.end > m.end {
+                        latest = Some(it);
+                    }
+                } else {
+                    latest = Some(it);
+                }
+            }
+        }
+        Self::from_edges(n, next_vertex as usize, &edges)
+    }
+
+    fn from_edges(encounters: usize, vertices: usize, edges: &[(u32, u32, f64)]) -> Self {
+        let mut degree = vec![0usize; vertices + 1];
+        for &(a, b, _) in edges {
+            degree[a as usize + 1] += 1;
+            degree[b as usize + 1] += 1;
+        }
+        for i in 0..vertices {
+            degree[i + 1] += degree[i];
+        }
+        let offsets = degree;
+        let mut fill = offsets.clone();
+        let mut targets = vec![0u32; offsets[vertices]];
+        let mut weights = vec![0f64; offsets[vertices]];
+        for &(a, b, w) in edges {
+            for (x, y) in [(a, b), (b, a)] {
+                let k = fill[x as usize];
+                targets[k] = y;
+                weights[k] = w;
+                fill[x as usize] += 1;
+            }
+        }
+        Self {
+            encounters,
+            offsets,
+            targets,
+            weights,
+        }
+    }
+
+    /// Number of encounter vertices.
+    pub fn encounters(&self) -> usize {
+        self.encounters
+    }
+
+    /// Number of vertices, virtual static vertices included.
+    pub fn vertices(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of undirected edges.
+    pub fn edges(&self) -> usize {
+        self.targets.len() / 2
+    }
+
+    /// Shortest-path distances (seconds) from encounter `source` to every encounter
+    /// (`f64::INFINITY` where unreachable). Dijkstra with a binary heap: O((V + E) log V).
+    pub fn distances_from(&self, source: usize) -> Vec<f64> {
+        let mut dist = vec![f64::INFINITY; self.vertices()];
+        let mut heap = BinaryHeap::new();
+        dist[source] = 0.0;
+        // Non-negative f64 bit patterns order like the numbers, so u64 keys are exact.
+        heap.push(Reverse((0f64.to_bits(), source as u32)));
+        while let Some(Reverse((bits, u))) = heap.pop() {
+            let d = f64::from_bits(bits);
+            let u = u as usize;
+            if d > dist[u] {
+                continue;
+            }
+            for k in self.offsets[u]..self.offsets[u + 1] {
+                let v = self.targets[k] as usize;
+                let nd = d + self.weights[k];
+                if nd < dist[v] {
+                    dist[v] = nd;
+                    heap.push(Reverse((nd.to_bits(), v as u32)));
+                }
+            }
+        }
+        dist.truncate(self.encounters);
+        dist
+    }
+
+    /// Connected components of the encounter vertices: a label per encounter, labels
+    /// numbered by first appearance.
+    pub fn components(&self) -> Vec<usize> {
+        let nv = self.vertices();
+        let mut label = vec![usize::MAX; nv];
+        let mut next = 0;
+        let mut stack = Vec::new();
+        for s in 0..nv {
+            if label[s] != usize::MAX {
+                continue;
+            }
+            label[s] = next;
+            stack.push(s);
+            while let Some(u) = stack.pop() {
+                for k in self.offsets[u]..self.offsets[u + 1] {
+                    let v = self.targets[k] as usize;
+                    if label[v] == usize::MAX {
+                        label[v] = next;
+                        stack.push(v);
+                    }
+                }
+            }
+            next += 1;
+        }
+        // Renumber by first appearance among encounter vertices only.
+        let mut map = HashMap::new();
+        label[..self.encounters]
+            .iter()
+            .map(|l| {
+                let k = map.len();
+                *map.entry(*l).or_insert(k)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::StaticReason;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn gap(x: &Encounter, y: &Encounter) -> f64 {
+        (x.start.max(y.start) - x.end.min(y.end)).max(0.0)
+    }
+
+    fn meets(a: (f64, f64), b: (f64, f64)) -> bool {
+        a.0 <= b.1 && b.0 <= a.1
+    }
+
+    /// The paper's graph built literally (a clique per agent), then Floyd–Warshall.
+    fn clique_metric(enc: &[Encounter], statics: &[StaticInterval]) -> Vec<Vec<f64>> {
+        let n = enc.len();
+        let mut d = vec![vec![f64::INFINITY; n]; n];
+        for i in 0..n {
+            d[i][i] = 0.0;
+            for j in 0..n {
+                if i == j {
+                    continue;
+                }
+                let (x, y) = (&enc[i], &enc[j]);
+                for s in [x.a, x.b] {
+                    if s != y.a && s != y.b {
+                        continue;
+                    }
+                    let bridged = statics.iter().any(|st| {
+                        st.agent == s
+                            && meets((x.start, x.end), (st.start, st.end))
+                            && meets((y.start, y.end), (st.start, st.end))
+                    });
+                    let w = if bridged { 0.0 } else { gap(x, y) };
+                    d[i][j] = d[i][j].min(w);
+                }
+            }
+        }
+        for k in 0..n {
+            for i in 0..n {
+                for j in 0..n {
+                    let via = d[i][k] + d[k][j];
+                    if via < d[i][j] {
+                        d[i][j] = via;
+                    }
+                }
+            }
+        }
+        d
+    }
+
+    fn random_log(seed: u64, n: usize, agents: u32) -> (Vec<Encounter>, Vec<StaticInterval>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let enc = (0..n)
+            .map(|_| {
+                let a = rng.random_range(0..agents);
+                let mut b = rng.random_range(0..agents - 1);
+                if b >= a {
+                    b += 1;
+                }
+                let start: f64 = rng.random_range(0.0..100.0);
+                // Some exact ties and zero-length intervals on purpose.
+                let start = if rng.random_bool(0.2) {
+                    start.round()
+                } else {
+                    start
+                };
+                let len = if rng.random_bool(0.2) {
+                    0.0
+                } else {
+                    rng.random_range(0.0..15.0)
+                };
+                Encounter {
+                    start,
+                    end: start + len,
+                    a: a.min(b),
+                    b: a.max(b),
+                    truth: None,
+                }
+            })
+            .collect();
+        let statics = (0..agents / 2)
+            .map(|k| {
+                let start: f64 = rng.random_range(0.0..90.0);
+                StaticInterval {
+                    agent: k * 2,
+                    start,
+                    end: start + rng.random_range(0.0..30.0),
+                    reason: StaticReason::Landmark,
+                }
+            })
+            .collect();
+        (enc, statics)
+    }
+
+    #[test]
+    fn sparse_equals_clique() {
+        for seed in 0..40 {
+            let (enc, statics) = random_log(seed, 40, 6);
+            let g = EncounterGraph::build(&enc, &statics, Bridging::Paper);
+            let want = clique_metric(&enc, &statics);
+            for (i, row) in want.iter().enumerate() {
+                let got = g.distances_from(i);
+                for (j, w) in row.iter().enumerate() {
+                    assert!(
+                        (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
+                        "seed {seed}: d({i},{j}) sparse {} clique {}",
+                        got[j],
+                        w
+                    );
+                }
+            }
+            assert!(g.edges() <= 2 * enc.len() + enc.len() * 2);
+        }
+    }
+
+    #[test]
+    fn static_time_is_free_only_when_asked() {
+        // Agent 0 meets 1 at [0,1], is static over [1,50], meets 2 at [60,61].
+        let enc = vec![
+            Encounter {
+                start: 0.0,
+                end: 1.0,
+                a: 0,
+                b: 1,
+                truth: None,
+            },
+            Encounter {
+                start: 60.0,
+                end: 61.0,
+                a: 0,
+                b: 2,
+                truth: None,
+            },
+        ];
+        let st = vec![StaticInterval {
+            agent: 0,
+            start: 1.0,
+            end: 50.0,
+            reason: StaticReason::Pause,
+        }];
+        let paper = EncounterGraph::build(&enc, &st, Bridging::Paper);
+        assert_eq!(paper.distances_from(0)[1], 59.0);
+        let free = EncounterGraph::build(&enc, &st, Bridging::StaticTimeFree);
+        assert_eq!(free.distances_from(0)[1], 10.0);
+    }
+
+    #[test]
+    fn components_follow_shared_agents() {
+        let e = |a, b, t| Encounter {
+            start: t,
+            end: t,
+            a,
+            b,
+            truth: None,
+        };
+        let enc = vec![e(0, 1, 0.0), e(2, 3, 1.0), e(1, 4, 2.0), e(3, 5, 3.0)];
+        let g = EncounterGraph::build(&enc, &[], Bridging::Paper);
+        assert_eq!(g.components(), vec![0, 1, 0, 1]);
+        assert_eq!(g.distances_from(0)[2], 2.0);
+        assert!(g.distances_from(0)[1].is_infinite());
+    }
+}

@@ -1,0 +1,3 @@
+//! Local and global mapping from encounter logs (paper §"Dynamic Topological Mapping").
+
+pub mod encounter_graph;
