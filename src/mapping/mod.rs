@@ -1,3 +1,5 @@
 //! Local and global mapping from encounter logs (paper §"Dynamic Topological Mapping").
 
 pub mod encounter_graph;
+pub mod subsample;
+pub mod windows;
