@@ -1,5 +1,6 @@
 //! Local and global mapping from encounter logs (paper §"Dynamic Topological Mapping").
 
+pub mod classify;
 pub mod encounter_graph;
 pub mod subsample;
 pub mod windows;

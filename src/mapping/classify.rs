@@ -1,0 +1,131 @@
+//! Robust classification of persistence features (paper §"Topological Feature
+//! Extraction": "robust classification of topological features … using statistical learning
+//! techniques as described in [Dirafzoon 2014]").
+//!
+//! The encounter metric is in seconds and its scale changes with the swarm's speed, the
+//! detection radius and the window's length, so the rule must be scale-invariant. Every
+//! diagram is measured against its own *sampling scale* σ: the median death of the finite
+//! H0 bars, i.e. the typical distance at which a representative joins its neighbours.
+//! - An H0 class is robust if it is essential (one per component of the encounter graph)
+//!   or its death exceeds `h0_ratio · σ`: a cluster separated by much more than the
+//!   sampling scale.
+//! - An H1 class is robust if its multiplicative persistence `death / birth` is at least
+//!   `h1_ratio` and its additive persistence `death − birth` is at least `h1_span · σ`.
+//!   The ratio is the standard scale-free noise test for Rips diagrams (noise loops die
+//!   shortly after they are born); the span rejects loops that are long-lived only
+//!   relative to a tiny birth.
+//!
+//! The three thresholds are fitted by `swarmmap calibrate` on training worlds and shipped as
+//! the default model in `assets/classifier.json`.
+
+use serde::{Deserialize, Serialize};
+
+/// The fitted thresholds of the classifier.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Classifier {
+    /// A finite H0 class is robust if `death > h0_ratio · σ`.
+    pub h0_ratio: f64,
+    /// An H1 class is robust if `death / birth ≥ h1_ratio` …
+    pub h1_ratio: f64,
+    /// … and `death − birth ≥ h1_span · σ`.
+    pub h1_span: f64,
+}
+
+impl Default for Classifier {
+    /// The shipped model (`assets/classifier.json`).
+    fn default() -> Self {
+        serde_json::from_str(include_str!("../../assets/classifier.json"))
+            .expect("assets/classifier.json is a valid classifier")
+    }
+}
+
+/// A bar as the classifier sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Feature {
+    pub dim: usize,
+    pub birth: f64,
+    pub death: f64,
+}
+
+/// The sampling scale σ of a diagram: the median finite H0 death (0 if there is none).
+pub fn sampling_scale(features: &[Feature]) -> f64 {
+    let mut d: Vec<f64> = features
+        .iter()
+        .filter(|f| f.dim == 0 && f.death.is_finite())
+        .map(|f| f.death)
+        .collect();
+    if d.is_empty() {
+        return 0.0;
+    }
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+impl Classifier {
+    /// Whether each feature is robust, given the diagram's sampling scale `sigma`.
+    pub fn robust(&self, f: &Feature, sigma: f64) -> bool {
+        match f.dim {
+            0 => f.death.is_infinite() || f.death > self.h0_ratio * sigma,
+            1 => {
+                f.death.is_finite()
+                    && f.birth > 0.0
+                    && f.death / f.birth >= self.h1_ratio
+                    && f.death - f.birth >= self.h1_span * sigma
+                    || f.birth == 0.0 && f.death > self.h1_span * sigma
+            }
+            _ => false,
+        }
+    }
+
+    /// (β0, β1): the number of robust classes in each dimension.
+    pub fn betti(&self, features: &[Feature]) -> [usize; 2] {
+        let sigma = sampling_scale(features);
+        let mut b = [0, 0];
+        for f in features {
+            if f.dim < 2 && self.robust(f, sigma) {
+                b[f.dim] += 1;
+            }
+        }
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f(dim: usize, birth: f64, death: f64) -> Feature {
+        Feature { dim, birth, death }
+    }
+
+    #[test]
+    fn the_rule_is_scale_invariant() {
+        let c = Classifier {
+            h0_ratio: 5.0,
+            h1_ratio: 2.0,
+            h1_span: 3.0,
+        };
+        let diagram = vec![
+            f(0, 0.0, 1.0),
+            f(0, 0.0, 1.0),
+            f(0, 0.0, 1.2),
+            f(0, 0.0, 8.0),
+            f(0, 0.0, f64::INFINITY),
+            f(1, 2.0, 2.5),
+            f(1, 2.0, 9.0),
+        ];
+        assert_eq!(c.betti(&diagram), [2, 1]);
+        let scaled: Vec<Feature> = diagram
+            .iter()
+            .map(|x| f(x.dim, 37.0 * x.birth, 37.0 * x.death))
+            .collect();
+        assert_eq!(c.betti(&scaled), [2, 1]);
+    }
+
+    #[test]
+    fn shipped_model_loads() {
+        let c = Classifier::default();
+        assert!(c.h0_ratio > 0.0 && c.h1_ratio >= 1.0 && c.h1_span > 0.0);
+    }
+}
