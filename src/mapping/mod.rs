@@ -3,4 +3,5 @@
 pub mod classify;
 pub mod encounter_graph;
 pub mod subsample;
+pub mod synthetic;
 pub mod windows;
