@@ -79,11 +79,7 @@ fn cases() -> Vec<Case> {
             name: "long rect touching nothing",
             world: world(vec![rect(3.0, 2.0, 7.0, 3.0)]),
             global: [1, 1],
-            bands: vec![
-                (2.0, 8.0, [1, 1]),
-                (4.0, 6.0, [2, 0]),
-                (2.0, 5.0, [1, 0]),
-            ],
+            bands: vec![(2.0, 8.0, [1, 1]), (4.0, 6.0, [2, 0]), (2.0, 5.0, [1, 0])],
         },
         Case {
             name: "obstacle touching the top wall",
@@ -180,7 +176,9 @@ fn ring(cx: f64, cy: f64, half: f64, thickness: f64) -> Vec<Obstacle> {
         (cx + half, cy + half),
         (cx - half, cy + half),
     ];
-    (0..4).map(|k| wall(c[k], c[(k + 1) % 4], thickness)).collect()
+    (0..4)
+        .map(|k| wall(c[k], c[(k + 1) % 4], thickness))
+        .collect()
 }
 
 /// A simple non-convex polygon: the outline of a 2 m × 2 m box with 0.3 m thick sides
@@ -270,7 +268,10 @@ fn empty_arena_area_matches_closed_form() {
     // The inner raster loses at most a strip of about 2 cells along the boundary.
     let perimeter = 2.0 * (10.0 + 5.0);
     let area = fs.reachable_area();
-    assert!(area <= exact && exact - area < perimeter * 0.012, "{area} vs {exact}");
+    assert!(
+        area <= exact && exact - area < perimeter * 0.012,
+        "{area} vs {exact}"
+    );
 }
 
 #[test]
@@ -285,7 +286,10 @@ fn ring_pocket_is_not_space() {
     let expected = (10.0 - 0.008) * (5.0 - 0.008) - 2.108f64.powi(2);
     let perimeter = 30.0 + 4.0 * 2.108;
     let area = fs.reachable_area();
-    assert!(area <= expected && expected - area < perimeter * 0.012, "{area} vs {expected}");
+    assert!(
+        area <= expected && expected - area < perimeter * 0.012,
+        "{area} vs {expected}"
+    );
 }
 
 #[test]

@@ -133,8 +133,8 @@ pub fn procrustes(est: &[[f64; 2]], truth: &[[f64; 2]]) -> Option<Procrustes> {
         [sx / n, sy / n]
     };
     let (cx, cy) = (centroid(est), centroid(truth));
-    // M = XᵀY with X, Y centred; ‖X‖², ‖Y‖².
-    let (mut m, mut xx, mut yy) = ([[0.0f64; 2]; 2], 0.0, 0.0);
+    // M = XᵀY with X, Y centred, and ‖X‖².
+    let (mut m, mut xx) = ([[0.0f64; 2]; 2], 0.0);
     for (p, q) in est.iter().zip(truth) {
         let x = [p[0] - cx[0], p[1] - cx[1]];
         let y = [q[0] - cy[0], q[1] - cy[1]];
@@ -144,7 +144,6 @@ pub fn procrustes(est: &[[f64; 2]], truth: &[[f64; 2]]) -> Option<Procrustes> {
             }
         }
         xx += x[0] * x[0] + x[1] * x[1];
-        yy += y[0] * y[0] + y[1] * y[1];
     }
     let [[a, b], [c, d]] = m;
     let rot = (a + d).hypot(b - c);
@@ -158,11 +157,19 @@ pub fn procrustes(est: &[[f64; 2]], truth: &[[f64; 2]]) -> Option<Procrustes> {
         let t = (b + c).atan2(a - d);
         (refl, [[t.cos(), t.sin()], [t.sin(), -t.cos()]])
     };
-    let (scale, residual) = if xx > 0.0 {
-        (nuclear / xx, (yy - nuclear * nuclear / xx).max(0.0))
-    } else {
-        (0.0, yy)
-    };
+    let scale = if xx > 0.0 { nuclear / xx } else { 0.0 };
+    // The closed form ‖Y‖² − ‖M‖*² / ‖X‖² cancels catastrophically for near-perfect fits
+    // (the rms would only be good to √ε); summing the actual residuals keeps full precision.
+    let residual: f64 = est
+        .iter()
+        .zip(truth)
+        .map(|(p, t)| {
+            let x = [p[0] - cx[0], p[1] - cx[1]];
+            let fx = scale * (q[0][0] * x[0] + q[0][1] * x[1]) - (t[0] - cy[0]);
+            let fy = scale * (q[1][0] * x[0] + q[1][1] * x[1]) - (t[1] - cy[1]);
+            fx * fx + fy * fy
+        })
+        .sum();
     let moved = [
         scale * (q[0][0] * cx[0] + q[0][1] * cx[1]),
         scale * (q[1][0] * cx[0] + q[1][1] * cx[1]),
