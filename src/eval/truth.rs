@@ -535,7 +535,7 @@ fn count_holes_8(mask: &[bool], ncols: usize, ny: usize) -> usize {
     let boundary = (0..ny)
         .flat_map(|j| [j, (ncols - 1) * ny + j])
         .chain((0..ncols).flat_map(|i| [i * ny, i * ny + ny - 1]));
-    for k in boundary.collect::<Vec<_>>() {
+    for k in boundary {
         if !mask[k] && !seen[k] {
             flood(k, &mut seen);
         }
