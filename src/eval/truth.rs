@@ -52,7 +52,7 @@
 //! then labels the components of F once by flood fill (O(n_cells)); a 30 m × 10 m arena at
 //! 1 cm (3 M cells) with four obstacles takes about 0.15 s in a release build. A band query
 //! labels only the band's cells, O(band cells) with a fresh scratch buffer (so [`FreeSpace`]
-//! is `Sync` and can be shared by parallel evaluation): about 3 ms for a 3 m band (test
+//! is `Sync` and can be shared by parallel evaluation): 3–5 ms for a 3 m band (test
 //! `paper_sized_arena_is_fast` in `tests/truth.rs` prints both).
 
 use thiserror::Error;
