@@ -29,7 +29,7 @@ pub struct PersistenceArgs {
     pub maxdim: usize,
     /// Largest edge length, in the input's distance units (default: the enclosing radius,
     /// which gives the same diagram as no threshold).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
     /// Add a `cycle` column with a representative cycle of every H1 bar.
     #[arg(long)]

@@ -17,7 +17,7 @@ pub fn bars(d: &Diagram, dim: usize) -> Vec<(f64, f64)> {
 }
 
 pub fn significant(birth: f64, death: f64) -> bool {
-    death - birth > 1e-9 * death.abs().max(birth.abs()).max(1e-300)
+    death == f64::INFINITY || death - birth > 1e-9 * death.abs().max(birth.abs()).max(1e-300)
 }
 
 pub fn close(a: f64, b: f64, rel: f64) -> bool {

@@ -107,9 +107,9 @@ fn diagram<M: Metric>(m: &M, opts: &RipsOptions) -> Diagram {
         let mut b = bar(1, birth, death);
         if opts.cycles {
             b.cycle = reps.remove(&p.birth).map(|c| {
-                c.iter()
-                    .map(|e| (e.b as usize, e.a as usize))
-                    .collect::<Vec<_>>()
+                let mut c: Vec<_> = c.iter().map(|e| (e.b as usize, e.a as usize)).collect();
+                c.sort_unstable();
+                c
             });
         }
         bars.push(b);
