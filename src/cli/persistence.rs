@@ -1,0 +1,148 @@
+//! `swarmmap persistence FILE`: the Vietoris–Rips persistence diagram of a CSV file.
+//!
+//! Input: one point a row, comma separated, no header; or, with `--distance-matrix`, a full
+//! symmetric matrix with a zero diagonal. Output on stdout: a header and one row per bar,
+//! `dim,birth,death` (`inf` for an essential class), sorted by `(dim, birth, death)`. With
+//! `--cycles` a fourth column `cycle` holds, for H1 bars, the edges of a representative
+//! cycle as `i-j;k-l;…` (0-based row numbers of the input, `i < j`), empty for H0 bars.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow};
+use clap::Args;
+
+use super::{Failure, input};
+use swarmmap::topology::rips::{Diagram, RipsOptions, rips_matrix, rips_points};
+use swarmmap::topology::{DistanceMatrix, MatrixError, PointCloud};
+
+/// Options of `swarmmap persistence`.
+#[derive(Debug, Args)]
+pub struct PersistenceArgs {
+    /// CSV file: one point per row, comma separated, no header.
+    pub file: PathBuf,
+    /// Read FILE as a full n×n distance matrix instead of points.
+    #[arg(long)]
+    pub distance_matrix: bool,
+    /// Highest homology dimension, 0 or 1.
+    #[arg(long, default_value_t = 1)]
+    pub maxdim: usize,
+    /// Largest edge length, in the input's distance units (default: the enclosing radius,
+    /// which gives the same diagram as no threshold).
+    #[arg(long, allow_hyphen_values = true)]
+    pub threshold: Option<f64>,
+    /// Add a `cycle` column with a representative cycle of every H1 bar.
+    #[arg(long)]
+    pub cycles: bool,
+    /// Worker threads; 0 uses all cores.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+/// Runs the subcommand.
+pub fn run(args: PersistenceArgs) -> Result<(), Failure> {
+    let opts = RipsOptions {
+        maxdim: args.maxdim,
+        threshold: args.threshold,
+        cycles: args.cycles,
+        threads: args.threads,
+    }
+    .check()
+    .map_err(input)?;
+    let text = std::fs::read_to_string(&args.file)
+        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    let rows = parse_rows(&text).map_err(|e| input(anyhow!("{}:{e}", args.file.display())))?;
+    let diagram = if args.distance_matrix {
+        let m = matrix(&rows).map_err(|e| input(located(&args.file, &rows, e)))?;
+        rips_matrix(&m, &opts)
+    } else {
+        let p = points(&rows).map_err(|e| input(located(&args.file, &rows, e)))?;
+        rips_points(&p, &opts)
+    };
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    write_diagram(&mut out, &diagram, args.cycles)?;
+    out.flush()?;
+    Ok(())
+}
+
+/// A CSV row: its 1-based line number and its numbers.
+type Row = (u64, Vec<f64>);
+
+/// Parses rows of numbers; errors read `LINE: message` (blank lines are skipped).
+fn parse_rows(text: &str) -> Result<Vec<Row>, String> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let mut rows: Vec<Row> = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| format!("{}: {e}", e.position().map_or(0, |p| p.line())))?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let mut vals = Vec::with_capacity(rec.len());
+        for (col, field) in rec.iter().enumerate() {
+            let v: f64 = field.parse().map_err(|_| {
+                format!(
+                    "{line}: column {}: '{field}' is not a number; every field must be a decimal number",
+                    col + 1
+                )
+            })?;
+            vals.push(v);
+        }
+        if let Some((first_line, first)) = rows.first()
+            && first.len() != vals.len()
+        {
+            return Err(format!(
+                "{line}: row has {} columns but line {first_line} has {}; every row needs the same number of columns",
+                vals.len(),
+                first.len()
+            ));
+        }
+        rows.push((line, vals));
+    }
+    if rows.is_empty() {
+        return Err(" the file has no rows; expected one point (or matrix row) per line".into());
+    }
+    Ok(rows)
+}
+
+fn points(rows: &[Row]) -> Result<PointCloud, MatrixError> {
+    let r: Vec<&[f64]> = rows.iter().map(|(_, v)| v.as_slice()).collect();
+    PointCloud::from_rows(&r)
+}
+
+fn matrix(rows: &[Row]) -> Result<DistanceMatrix, MatrixError> {
+    let r: Vec<&[f64]> = rows.iter().map(|(_, v)| v.as_slice()).collect();
+    DistanceMatrix::from_full(&r)
+}
+
+/// Prefixes a matrix error with `FILE:LINE:` of the offending row.
+fn located(file: &Path, rows: &[Row], e: MatrixError) -> anyhow::Error {
+    let row = match e {
+        MatrixError::NonFinite { row, .. }
+        | MatrixError::NotSquare { row, .. }
+        | MatrixError::Diagonal { row, .. }
+        | MatrixError::BadEntry { row, .. }
+        | MatrixError::Asymmetric { row, .. } => Some(row),
+        _ => None,
+    };
+    match row.and_then(|r| rows.get(r)) {
+        Some((line, _)) => anyhow!("{}:{line}: {e}", file.display()),
+        None => anyhow!("{}: {e}", file.display()),
+    }
+}
+
+/// Writes the diagram as CSV (see the module docs).
+pub fn write_diagram(w: &mut dyn Write, d: &Diagram, cycles: bool) -> std::io::Result<()> {
+    writeln!(w, "dim,birth,death{}", if cycles { ",cycle" } else { "" })?;
+    for b in &d.bars {
+        write!(w, "{},{},{}", b.dim, b.birth, b.death)?;
+        if cycles {
+            let c = b.cycle.as_deref().unwrap_or(&[]);
+            let s: Vec<String> = c.iter().map(|(i, j)| format!("{i}-{j}")).collect();
+            write!(w, ",{}", s.join(";"))?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}

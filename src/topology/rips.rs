@@ -1,1 +1,0 @@
-//! Placeholder until the topology engine lands (issue #3).
