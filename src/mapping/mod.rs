@@ -2,6 +2,8 @@
 
 pub mod classify;
 pub mod encounter_graph;
+pub mod local;
+pub mod output;
 pub mod subsample;
 pub mod synthetic;
 pub mod windows;

@@ -1,0 +1,259 @@
+//! Local topological maps (paper §"Local Mapping"): from the encounters of one time window,
+//! the encounter point cloud of its domain and its robust components and holes.
+//!
+//! Per window W_i:
+//! 1. the encounters whose interval meets W_i, and the static intervals meeting it;
+//! 2. the sparse encounter graph ([`super::encounter_graph`]) and its components; a
+//!    component with fewer than `min_component` encounters (or a share below
+//!    `min_share` of the window's) is noise — a few stray encounters, not a region;
+//! 3. per real component, m representatives by density-aware MaxMin
+//!    ([`super::subsample`]); their distance rows give the m × m encounter metric for
+//!    Vietoris–Rips persistence (H0, H1) and, by landmark MDS, a 3-D embedding of every
+//!    encounter of the component (the encounter point cloud);
+//! 4. the classifier ([`super::classify`]) keeps the robust classes; (β0, β1) sum over
+//!    components.
+//!
+//! Cost per window: O(m · (n + E) log n) for the shortest paths, O(m²) memory for the
+//! metric, O(m · n) for the rows; never O(n²).
+
+use super::classify::{Classifier, Feature, sampling_scale};
+use super::encounter_graph::{Bridging, EncounterGraph};
+use super::subsample::{SubsampleParams, subsample};
+use super::windows::Window;
+use crate::log::{Encounter, EncounterLog};
+use crate::topology::DistanceMatrix;
+use crate::topology::mds::landmark_mds;
+use crate::topology::rips::{RipsOptions, rips_matrix};
+use serde::Serialize;
+
+/// Parameters of local mapping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalParams {
+    /// How static intervals bridge time (default: the paper's rule).
+    pub bridging: Bridging,
+    /// Subsampling (default: m = 400).
+    pub subsample: SubsampleParams,
+    /// Smallest number of encounters of a real component (default: `20`).
+    pub min_component: usize,
+    /// Smallest share of the window's encounters of a real component (default: `0.02`).
+    pub min_share: f64,
+    /// The robust-feature classifier (default: the shipped model).
+    pub classifier: Classifier,
+}
+
+impl Default for LocalParams {
+    fn default() -> Self {
+        Self {
+            bridging: Bridging::Paper,
+            subsample: SubsampleParams::default(),
+            min_component: 20,
+            min_share: 0.02,
+            classifier: Classifier::default(),
+        }
+    }
+}
+
+/// A bar of a component's diagram, with its robustness.
+#[derive(Debug, Clone, Serialize)]
+pub struct MapBar {
+    pub dim: usize,
+    pub birth: f64,
+    /// `null` in JSON for an essential class.
+    pub death: Option<f64>,
+    pub robust: bool,
+}
+
+/// A robust hole: its bar and a representative cycle as encounters (indices into the
+/// window's `events`, consecutive pairs joined by an edge of the metric).
+#[derive(Debug, Clone, Serialize)]
+pub struct Hole {
+    pub birth: f64,
+    pub death: f64,
+    /// Edges of the representative cycle, as pairs of indices into `events`.
+    pub cycle: Vec<(usize, usize)>,
+}
+
+/// One real component of a window's encounter graph.
+#[derive(Debug, Clone, Serialize)]
+pub struct Component {
+    /// Indices into the window's `events`.
+    pub events: Vec<usize>,
+    /// Indices into the window's `events` of the representatives.
+    pub representatives: Vec<usize>,
+    /// Sampling scale σ of the diagram, seconds.
+    pub scale: f64,
+    pub diagram: Vec<MapBar>,
+    /// (β0, β1) of this component.
+    pub betti: [usize; 2],
+    pub holes: Vec<Hole>,
+}
+
+/// The local map of one window.
+#[derive(Debug, Clone, Serialize)]
+pub struct LocalMap {
+    pub index: usize,
+    pub start: f64,
+    pub end: f64,
+    /// Indices into the log's encounters of the window's events.
+    pub events: Vec<usize>,
+    /// 3-D encounter point cloud, one point per event (NaN-free; events of noise
+    /// components sit at the origin and are flagged in `noise`).
+    pub points: Vec<[f64; 3]>,
+    /// Whether each event belongs to a noise component.
+    pub noise: Vec<bool>,
+    pub components: Vec<Component>,
+    /// Estimated (β0, β1).
+    pub betti: [usize; 2],
+    /// Share of the MDS spectrum carried by the 3 kept dimensions (mean over components).
+    pub explained: f64,
+    /// Distance rows from each component's representatives, kept for fidelity and
+    /// stitching: `(event index, row over the window's events)`.
+    #[serde(skip)]
+    pub rows: Vec<(usize, Vec<f64>)>,
+}
+
+/// Builds the local map of `window` from `log`.
+pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalMap {
+    let events: Vec<usize> = log
+        .encounters
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| window.meets(e.start, e.end))
+        .map(|(i, _)| i)
+        .collect();
+    let enc: Vec<Encounter> = events.iter().map(|&i| log.encounters[i].clone()).collect();
+    let statics: Vec<_> = log
+        .static_intervals
+        .iter()
+        .filter(|s| window.meets(s.start, s.end))
+        .filter(|s| {
+            p.bridging == Bridging::StaticTimeFree || s.reason == crate::log::StaticReason::Landmark
+        })
+        .cloned()
+        .collect();
+    let graph = EncounterGraph::build(&enc, &statics, p.bridging);
+    let labels = graph.components();
+    let n = enc.len();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, &l) in labels.iter().enumerate() {
+        if l >= groups.len() {
+            groups.resize(l + 1, Vec::new());
+        }
+        groups[l].push(i);
+    }
+    let min_size = p
+        .min_component
+        .max((p.min_share * n as f64).ceil() as usize);
+    let mut points = vec![[0.0; 3]; n];
+    let mut noise = vec![true; n];
+    let mut components = Vec::new();
+    let mut rows_out = Vec::new();
+    let mut explained = Vec::new();
+    for members in groups.into_iter().filter(|g| g.len() >= min_size.max(3)) {
+        let sub = subsample(&graph, &members, &p.subsample);
+        let m = sub.picks.len();
+        let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
+        let opts = RipsOptions {
+            maxdim: 1,
+            threshold: None,
+            cycles: true,
+            threads: 0,
+        };
+        let diagram = rips_matrix(&metric, &opts);
+        let features: Vec<Feature> = diagram
+            .bars
+            .iter()
+            .map(|b| Feature {
+                dim: b.dim,
+                birth: b.birth,
+                death: b.death,
+            })
+            .collect();
+        let sigma = sampling_scale(&features);
+        let mut betti = [0, 0];
+        let mut bars = Vec::new();
+        let mut holes = Vec::new();
+        for (bar, f) in diagram.bars.iter().zip(&features) {
+            let robust = p.classifier.robust(f, sigma);
+            if robust && f.dim < 2 {
+                betti[f.dim] += 1;
+            }
+            if robust && f.dim == 1 {
+                let cycle = bar
+                    .cycle
+                    .as_ref()
+                    .map(|c| {
+                        c.iter()
+                            .map(|&(x, y)| (sub.picks[x], sub.picks[y]))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                holes.push(Hole {
+                    birth: f.birth,
+                    death: f.death,
+                    cycle,
+                });
+            }
+            bars.push(MapBar {
+                dim: f.dim,
+                birth: f.birth,
+                death: f.death.is_finite().then_some(f.death),
+                robust,
+            });
+        }
+        // Embed every member of the component from the representatives' rows.
+        let rows: Vec<Vec<f64>> = sub
+            .rows
+            .iter()
+            .map(|r| members.iter().map(|&j| r[j]).collect())
+            .collect();
+        let local_picks: Vec<usize> = sub
+            .picks
+            .iter()
+            .map(|p| members.binary_search(p).unwrap_or(0))
+            .collect();
+        if let Ok(emb) = landmark_mds(&local_picks, &rows, 3) {
+            explained.push(emb.explained);
+            for (k, &j) in members.iter().enumerate() {
+                let c = emb.coords.point(k);
+                points[j] = [
+                    c.first().copied().unwrap_or(0.0),
+                    c.get(1).copied().unwrap_or(0.0),
+                    c.get(2).copied().unwrap_or(0.0),
+                ];
+            }
+        }
+        for &j in &members {
+            noise[j] = false;
+        }
+        rows_out.extend(sub.picks.iter().copied().zip(sub.rows));
+        components.push(Component {
+            events: members,
+            representatives: sub.picks,
+            scale: sigma,
+            diagram: bars,
+            betti,
+            holes,
+        });
+    }
+    let betti = components
+        .iter()
+        .fold([0, 0], |acc, c| [acc[0] + c.betti[0], acc[1] + c.betti[1]]);
+    let explained = if explained.is_empty() {
+        0.0
+    } else {
+        explained.iter().sum::<f64>() / explained.len() as f64
+    };
+    LocalMap {
+        index: window.index,
+        start: window.start,
+        end: window.end,
+        events,
+        points,
+        noise,
+        components,
+        betti,
+        explained,
+        rows: rows_out,
+    }
+}
