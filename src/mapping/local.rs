@@ -53,6 +53,18 @@ impl Default for LocalParams {
     }
 }
 
+impl LocalParams {
+    /// The parameters a world's `mapping` section selects.
+    pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
+        let mut p = Self::default();
+        p.subsample.m = m.subsample;
+        p.bridging = match m.method {
+            crate::world::MappingMethod::Paper => Bridging::Paper,
+        };
+        p
+    }
+}
+
 /// A bar of a component's diagram, with its robustness.
 #[derive(Debug, Clone, Serialize)]
 pub struct MapBar {

@@ -4,6 +4,7 @@ pub mod classify;
 pub mod encounter_graph;
 pub mod local;
 pub mod output;
+pub mod pipeline;
 pub mod subsample;
 pub mod synthetic;
 pub mod windows;

@@ -127,7 +127,12 @@ pub enum MdsError {
     #[error(
         "landmarks {a} and {b} are {ab} apart one way and {ba} the other; landmark distances must be symmetric"
     )]
-    Asymmetric { a: usize, b: usize, ab: f64, ba: f64 },
+    Asymmetric {
+        a: usize,
+        b: usize,
+        ab: f64,
+        ba: f64,
+    },
     #[error(
         "the eigensolver did not converge within a basis of {basis} vectors (residual {residual:e}); raise MdsOptions::max_basis"
     )]
@@ -229,7 +234,9 @@ pub fn landmark_mds_with(
             }
         }
     }
-    let dl = DistanceMatrix::from_fn(m, |a, b| 0.5 * (rows[a][landmarks[b]] + rows[b][landmarks[a]]));
+    let dl = DistanceMatrix::from_fn(m, |a, b| {
+        0.5 * (rows[a][landmarks[b]] + rows[b][landmarks[a]])
+    });
     let spec = top_spectrum(&dl, k, opts)?;
     let noise = spec.noise();
 
@@ -357,7 +364,13 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         if full || !exhaustive {
             let hm = DMatrix::from_fn(m, m, |i, j| {
                 let (a, b) = (h[j][i], h[i][j]);
-                if a.is_nan() { b } else if b.is_nan() { a } else { 0.5 * (a + b) }
+                if a.is_nan() {
+                    b
+                } else if b.is_nan() {
+                    a
+                } else {
+                    0.5 * (a + b)
+                }
             });
             let eig = SymmetricEigen::new(hm);
             let order = descending(&eig.eigenvalues.as_slice().to_vec());
@@ -688,7 +701,10 @@ fn slq_abs_trace(
         if active.is_empty() {
             break;
         }
-        let current: Vec<Vec<f64>> = active.iter().map(|&p| lv[p].last().cloned().unwrap_or_default()).collect();
+        let current: Vec<Vec<f64>> = active
+            .iter()
+            .map(|&p| lv[p].last().cloned().unwrap_or_default())
+            .collect();
         let products = apply_b(d, &current);
         for (&p, mut w) in active.iter().zip(products) {
             project_out(&mut w, basis);
@@ -747,7 +763,11 @@ mod tests {
         // Two points 2 apart: B has eigenvalues 2 and 0.
         let two = DistanceMatrix::from_condensed(2, vec![2.0]).unwrap();
         let e = classical_mds(&two, 3).unwrap();
-        assert!((e.eigenvalues[0] - 2.0).abs() < 1e-12, "{:?}", e.eigenvalues);
+        assert!(
+            (e.eigenvalues[0] - 2.0).abs() < 1e-12,
+            "{:?}",
+            e.eigenvalues
+        );
         assert_eq!(&e.eigenvalues[1..], &[0.0, 0.0]);
         let x = e.coords.coords();
         assert!(((x[0] - x[3]).abs() - 2.0).abs() < 1e-12);
