@@ -5,6 +5,7 @@ pub mod encounter_graph;
 pub mod local;
 pub mod output;
 pub mod pipeline;
+pub mod stitch;
 pub mod subsample;
 pub mod synthetic;
 pub mod windows;
