@@ -235,12 +235,7 @@ impl Dendrogram {
 
     /// Number of flat clusters at `threshold` (as in [`Dendrogram::cut`]), in O(merges).
     pub fn n_clusters(&self, threshold: f64) -> usize {
-        self.n
-            - self
-                .merges
-                .iter()
-                .filter(|m| m.height <= threshold)
-                .count()
+        self.n - self.merges.iter().filter(|m| m.height <= threshold).count()
     }
 }
 
@@ -282,7 +277,11 @@ mod tests {
         let one = single_linkage(&DistanceMatrix::zeros(1));
         assert!(one.merges.is_empty());
         assert_eq!(one.cut(0.0), vec![0]);
-        assert!(single_linkage(&DistanceMatrix::zeros(0)).cut(1.0).is_empty());
+        assert!(
+            single_linkage(&DistanceMatrix::zeros(0))
+                .cut(1.0)
+                .is_empty()
+        );
     }
 
     #[test]

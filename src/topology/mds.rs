@@ -127,7 +127,14 @@ pub enum MdsError {
     #[error(
         "landmarks {a} and {b} are {ab} apart one way and {ba} the other; landmark distances must be symmetric"
     )]
-    Asymmetric { a: usize, b: usize, ab: f64, ba: f64 },
+    Asymmetric {
+        a: usize,
+        b: usize,
+        ab: f64,
+        ba: f64,
+    },
+    #[error("the squared distances overflow f64; rescale the distances (e.g. to kilometres)")]
+    Overflow,
     #[error(
         "the eigensolver did not converge within a basis of {basis} vectors (residual {residual:e}); raise MdsOptions::max_basis"
     )]
@@ -229,7 +236,9 @@ pub fn landmark_mds_with(
             }
         }
     }
-    let dl = DistanceMatrix::from_fn(m, |a, b| 0.5 * (rows[a][landmarks[b]] + rows[b][landmarks[a]]));
+    let dl = DistanceMatrix::from_fn(m, |a, b| {
+        0.5 * (rows[a][landmarks[b]] + rows[b][landmarks[a]])
+    });
     let spec = top_spectrum(&dl, k, opts)?;
     let noise = spec.noise();
 
@@ -328,6 +337,23 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         return Err(MdsError::ZeroDimension);
     }
     let n = d.len();
+    // DistanceMatrix::from_fn does not validate, so check here: NaN would stall the eigensolver.
+    if let Some(pos) = d
+        .condensed()
+        .iter()
+        .position(|v| !v.is_finite() || *v < 0.0)
+    {
+        let (row, col) = condensed_position(n, pos);
+        return Err(MdsError::BadDistance {
+            row,
+            col,
+            value: d.condensed()[pos],
+        });
+    }
+    let trace_b = d.condensed().iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64;
+    if !trace_b.is_finite() {
+        return Err(MdsError::Overflow);
+    }
     let dim = n.saturating_sub(1); // B lives on 1⊥
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let exhaustive = dim <= opts.exact_below;
@@ -346,8 +372,8 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
             bq.push(w);
         }
         let m = q.len();
-        for j in h.len()..m {
-            let col: Vec<f64> = (0..m).map(|i| dot(&q[i], &bq[j])).collect();
+        for w in &bq[h.len()..m] {
+            let col: Vec<f64> = q.iter().map(|qi| dot(qi, w)).collect();
             h.push(col);
         }
         for col in h.iter_mut() {
@@ -357,10 +383,16 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         if full || !exhaustive {
             let hm = DMatrix::from_fn(m, m, |i, j| {
                 let (a, b) = (h[j][i], h[i][j]);
-                if a.is_nan() { b } else if b.is_nan() { a } else { 0.5 * (a + b) }
+                if a.is_nan() {
+                    b
+                } else if b.is_nan() {
+                    a
+                } else {
+                    0.5 * (a + b)
+                }
             });
             let eig = SymmetricEigen::new(hm);
-            let order = descending(&eig.eigenvalues.as_slice().to_vec());
+            let order = descending(eig.eigenvalues.as_slice());
             let values: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
             let radius = values.iter().fold(0.0f64, |a, l| a.max(l.abs()));
             let mut worst = 0.0f64;
@@ -406,7 +438,6 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         masses(&values)
     } else {
         let (pq, nq) = masses(&values);
-        let trace_b = d.condensed().iter().map(|x| x * x).sum::<f64>() / n as f64;
         let trace_r = trace_b - values.iter().sum::<f64>();
         let abs_r = slq_abs_trace(d, &q, opts, &mut rng).max(trace_r.abs());
         (pq + 0.5 * (abs_r + trace_r), nq + 0.5 * (abs_r - trace_r))
@@ -441,6 +472,19 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         exact,
         radius,
     })
+}
+
+/// `(i, j)`, `i < j`, of position `pos` in the condensed layout of an `n × n` matrix.
+fn condensed_position(n: usize, pos: usize) -> (usize, usize) {
+    let mut start = 0;
+    for i in 0..n {
+        let len = n - i - 1;
+        if pos < start + len {
+            return (i, i + 1 + pos - start);
+        }
+        start += len;
+    }
+    (n, n)
 }
 
 /// Sums of the positive and of the negative (as a magnitude) values, ignoring rounding noise.
@@ -688,7 +732,10 @@ fn slq_abs_trace(
         if active.is_empty() {
             break;
         }
-        let current: Vec<Vec<f64>> = active.iter().map(|&p| lv[p].last().cloned().unwrap_or_default()).collect();
+        let current: Vec<Vec<f64>> = active
+            .iter()
+            .map(|&p| lv[p].last().cloned().unwrap_or_default())
+            .collect();
         let products = apply_b(d, &current);
         for (&p, mut w) in active.iter().zip(products) {
             project_out(&mut w, basis);
@@ -745,9 +792,20 @@ mod tests {
         let empty = classical_mds(&DistanceMatrix::zeros(0), 3).unwrap();
         assert!(empty.coords.is_empty());
         // Two points 2 apart: B has eigenvalues 2 and 0.
+        let nan = DistanceMatrix::from_fn(3, |i, j| if (i, j) == (1, 2) { f64::NAN } else { 1.0 });
+        assert!(matches!(
+            classical_mds(&nan, 2),
+            Err(MdsError::BadDistance { row: 1, col: 2, .. })
+        ));
+        let huge = DistanceMatrix::from_fn(3, |_, _| 1e200);
+        assert_eq!(classical_mds(&huge, 2), Err(MdsError::Overflow));
         let two = DistanceMatrix::from_condensed(2, vec![2.0]).unwrap();
         let e = classical_mds(&two, 3).unwrap();
-        assert!((e.eigenvalues[0] - 2.0).abs() < 1e-12, "{:?}", e.eigenvalues);
+        assert!(
+            (e.eigenvalues[0] - 2.0).abs() < 1e-12,
+            "{:?}",
+            e.eigenvalues
+        );
         assert_eq!(&e.eigenvalues[1..], &[0.0, 0.0]);
         let x = e.coords.coords();
         assert!(((x[0] - x[3]).abs() - 2.0).abs() < 1e-12);
