@@ -11,7 +11,11 @@ fn read_rows(path: &str) -> Vec<Vec<f64>> {
     text.lines()
         .filter(|l| !l.trim().is_empty())
         .filter(|l| l.trim().parse::<f64>().is_ok() || l.contains(','))
-        .map(|l| l.split(',').map(|x| x.trim().parse::<f64>().unwrap()).collect())
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.trim().parse::<f64>().unwrap())
+                .collect()
+        })
         .collect()
 }
 
@@ -86,9 +90,9 @@ fn brute_force_cut(d: &DistanceMatrix, t: f64) -> Vec<usize> {
         let mut stack = vec![s];
         label[s] = next;
         while let Some(i) = stack.pop() {
-            for j in 0..n {
-                if label[j] == usize::MAX && d.get(i, j) <= t {
-                    label[j] = next;
+            for (j, l) in label.iter_mut().enumerate() {
+                if *l == usize::MAX && d.get(i, j) <= t {
+                    *l = next;
                     stack.push(j);
                 }
             }

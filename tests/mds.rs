@@ -255,7 +255,10 @@ fn full_rows(d: &DistanceMatrix) -> Vec<Vec<f64>> {
 
 #[test]
 fn landmark_mds_with_every_point_a_landmark_is_classical_mds() {
-    for d in [random_metric(40, 5), DistanceMatrix::from_points(&random_points(70, 3, 6))] {
+    for d in [
+        random_metric(40, 5),
+        DistanceMatrix::from_points(&random_points(70, 3, 6)),
+    ] {
         let all: Vec<usize> = (0..d.len()).collect();
         let lm = landmark_mds(&all, &full_rows(&d), 3).unwrap();
         let cl = classical_mds(&d, 3).unwrap();
@@ -291,7 +294,10 @@ fn landmark_mds_recovers_planar_points_from_few_landmarks() {
 fn landmark_mds_rejects_bad_input() {
     let rows = vec![vec![0.0, 1.0, 2.0], vec![1.0, 0.0, 1.5]];
     assert_eq!(landmark_mds(&[], &[], 2), Err(MdsError::NoLandmarks));
-    assert_eq!(landmark_mds(&[0, 1], &rows, 0), Err(MdsError::ZeroDimension));
+    assert_eq!(
+        landmark_mds(&[0, 1], &rows, 0),
+        Err(MdsError::ZeroDimension)
+    );
     assert!(matches!(
         landmark_mds(&[0], &rows, 2),
         Err(MdsError::RowCount { .. })

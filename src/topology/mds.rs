@@ -133,6 +133,8 @@ pub enum MdsError {
         ab: f64,
         ba: f64,
     },
+    #[error("the squared distances overflow f64; rescale the distances (e.g. to kilometres)")]
+    Overflow,
     #[error(
         "the eigensolver did not converge within a basis of {basis} vectors (residual {residual:e}); raise MdsOptions::max_basis"
     )]
@@ -335,6 +337,23 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         return Err(MdsError::ZeroDimension);
     }
     let n = d.len();
+    // DistanceMatrix::from_fn does not validate, so check here: NaN would stall the eigensolver.
+    if let Some(pos) = d
+        .condensed()
+        .iter()
+        .position(|v| !v.is_finite() || *v < 0.0)
+    {
+        let (row, col) = condensed_position(n, pos);
+        return Err(MdsError::BadDistance {
+            row,
+            col,
+            value: d.condensed()[pos],
+        });
+    }
+    let trace_b = d.condensed().iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64;
+    if !trace_b.is_finite() {
+        return Err(MdsError::Overflow);
+    }
     let dim = n.saturating_sub(1); // B lives on 1⊥
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let exhaustive = dim <= opts.exact_below;
@@ -353,8 +372,8 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
             bq.push(w);
         }
         let m = q.len();
-        for j in h.len()..m {
-            let col: Vec<f64> = (0..m).map(|i| dot(&q[i], &bq[j])).collect();
+        for w in &bq[h.len()..m] {
+            let col: Vec<f64> = q.iter().map(|qi| dot(qi, w)).collect();
             h.push(col);
         }
         for col in h.iter_mut() {
@@ -373,7 +392,7 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
                 }
             });
             let eig = SymmetricEigen::new(hm);
-            let order = descending(&eig.eigenvalues.as_slice().to_vec());
+            let order = descending(eig.eigenvalues.as_slice());
             let values: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
             let radius = values.iter().fold(0.0f64, |a, l| a.max(l.abs()));
             let mut worst = 0.0f64;
@@ -419,7 +438,6 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         masses(&values)
     } else {
         let (pq, nq) = masses(&values);
-        let trace_b = d.condensed().iter().map(|x| x * x).sum::<f64>() / n as f64;
         let trace_r = trace_b - values.iter().sum::<f64>();
         let abs_r = slq_abs_trace(d, &q, opts, &mut rng).max(trace_r.abs());
         (pq + 0.5 * (abs_r + trace_r), nq + 0.5 * (abs_r - trace_r))
@@ -454,6 +472,19 @@ fn top_spectrum(d: &DistanceMatrix, k: usize, opts: &MdsOptions) -> Result<Spect
         exact,
         radius,
     })
+}
+
+/// `(i, j)`, `i < j`, of position `pos` in the condensed layout of an `n × n` matrix.
+fn condensed_position(n: usize, pos: usize) -> (usize, usize) {
+    let mut start = 0;
+    for i in 0..n {
+        let len = n - i - 1;
+        if pos < start + len {
+            return (i, i + 1 + pos - start);
+        }
+        start += len;
+    }
+    (n, n)
 }
 
 /// Sums of the positive and of the negative (as a magnitude) values, ignoring rounding noise.
@@ -761,6 +792,13 @@ mod tests {
         let empty = classical_mds(&DistanceMatrix::zeros(0), 3).unwrap();
         assert!(empty.coords.is_empty());
         // Two points 2 apart: B has eigenvalues 2 and 0.
+        let nan = DistanceMatrix::from_fn(3, |i, j| if (i, j) == (1, 2) { f64::NAN } else { 1.0 });
+        assert!(matches!(
+            classical_mds(&nan, 2),
+            Err(MdsError::BadDistance { row: 1, col: 2, .. })
+        ));
+        let huge = DistanceMatrix::from_fn(3, |_, _| 1e200);
+        assert_eq!(classical_mds(&huge, 2), Err(MdsError::Overflow));
         let two = DistanceMatrix::from_condensed(2, vec![2.0]).unwrap();
         let e = classical_mds(&two, 3).unwrap();
         assert!(
