@@ -44,6 +44,86 @@ pub fn point_in_polygon(p: Vec2, poly: &[Vec2]) -> bool {
     inside
 }
 
+/// Signed area of a polygon (shoelace formula), m²: positive when counter-clockwise.
+pub fn polygon_area(poly: &[Vec2]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a.0 * b.1 - b.0 * a.1
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Orientation of `c` relative to the directed line `a → b`: `1` left, `-1` right, `0`
+/// collinear (within a tolerance relative to the coordinates' magnitude).
+fn orientation(a: Vec2, b: Vec2, c: Vec2) -> i8 {
+    let cross = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
+    let scale = [a.0, a.1, b.0, b.1, c.0, c.1]
+        .iter()
+        .fold(1.0f64, |m, v| m.max(v.abs()));
+    let eps = 1e-12 * scale * scale;
+    if cross > eps {
+        1
+    } else if cross < -eps {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether `c`, known collinear with `[a, b]`, lies within the segment's bounding box.
+fn on_segment(a: Vec2, b: Vec2, c: Vec2) -> bool {
+    c.0 >= a.0.min(b.0) && c.0 <= a.0.max(b.0) && c.1 >= a.1.min(b.1) && c.1 <= a.1.max(b.1)
+}
+
+/// Whether the closed segments `[a, b]` and `[c, d]` share a point (touching counts).
+pub fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
+    let (o1, o2) = (orientation(a, b, c), orientation(a, b, d));
+    let (o3, o4) = (orientation(c, d, a), orientation(c, d, b));
+    if o1 != o2 && o3 != o4 && o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0 {
+        return true;
+    }
+    (o1 == 0 && on_segment(a, b, c))
+        || (o2 == 0 && on_segment(a, b, d))
+        || (o3 == 0 && on_segment(c, d, a))
+        || (o4 == 0 && on_segment(c, d, b))
+}
+
+/// The first pair of edges `(i, j)` (edge `i` runs from vertex `i` to `i + 1`) of the
+/// closed polygon that meet although they should not: non-adjacent edges that share a
+/// point, or adjacent edges that fold back over each other. `None` for a simple polygon.
+/// Brute force over all pairs, O(n²), fine for hand-written obstacles.
+pub fn polygon_self_intersection(poly: &[Vec2]) -> Option<(usize, usize)> {
+    let n = poly.len();
+    if n < 3 {
+        return None;
+    }
+    let edge = |i: usize| (poly[i], poly[(i + 1) % n]);
+    for i in 0..n {
+        for j in i + 1..n {
+            let (a, b) = edge(i);
+            let (c, d) = edge(j);
+            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+            if adjacent {
+                // They share one vertex; they overlap only if the far vertex of one lies on
+                // the other, collinear and inside it (a spike folding back).
+                let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                let folds = orientation(p, shared, q) == 0
+                    && ((q.0 - shared.0) * (p.0 - shared.0) + (q.1 - shared.1) * (p.1 - shared.1))
+                        > 0.0;
+                if folds {
+                    return Some((i, j));
+                }
+            } else if segments_intersect(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
 impl Obstacle {
     /// Signed distance from `p` to the obstacle's solid, metres: positive outside,
     /// zero on the boundary, negative inside (minus the depth to the boundary).
@@ -72,6 +152,11 @@ impl Obstacle {
                 thickness,
             } => segment_distance(p, *from, *to) - thickness / 2.0,
         }
+    }
+
+    /// Unsigned distance from `p` to the obstacle's solid, metres: zero inside or on it.
+    pub fn distance(&self, p: Vec2) -> f64 {
+        self.signed_distance(p).max(0.0)
     }
 
     /// Axis-aligned bounding box `(min, max)` of the solid.
