@@ -1,6 +1,8 @@
 //! Subcommands. Each lives in its own file and returns `Result<(), Failure>`; the exit
 //! code comes from the failure's kind, never from a panic.
 
+mod check;
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -36,11 +38,16 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Validate a world file and print a short summary.
+    Check(check::CheckArgs),
+}
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: Result<(), Failure> = match cli.command {};
+    let result: Result<(), Failure> = match cli.command {
+        Command::Check(args) => check::run(&args),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
