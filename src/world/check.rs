@@ -13,7 +13,7 @@
 
 use super::error::WorldError;
 use super::freespace::FreeSpaceRaster;
-use super::geometry::{polygon_area, polygon_self_intersection};
+use super::geometry::polygon_self_intersection;
 use super::locate::locate;
 use super::spec::{MethodSpec, ObstacleSpec, PlacementSpec, SpecOrigin, WorldSpec};
 use super::types::*;
@@ -38,14 +38,11 @@ impl Ctx<'_> {
             self.origin.name.as_str()
         };
         let by_override = self.origin.overrides.iter().rev().find(|(p, _)| {
-            field == p
-                || field.starts_with(&format!("{p}."))
-                || field.starts_with(&format!("{p}["))
+            field == p || field.starts_with(&format!("{p}.")) || field.starts_with(&format!("{p}["))
         });
         let location = if let Some((p, v)) = by_override {
             format!("{name} (--set {p}={v})")
-        } else if let Some((line, col)) =
-            self.origin.text.as_deref().and_then(|t| locate(t, field))
+        } else if let Some((line, col)) = self.origin.text.as_deref().and_then(|t| locate(t, field))
         {
             format!("{name}:{line}:{col}")
         } else {
@@ -72,7 +69,12 @@ impl Ctx<'_> {
         if v > 0.0 {
             Ok(v)
         } else {
-            Err(self.err(field, format!("is {v} (must be > 0 {unit})"), fix))
+            let unit = if unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            Err(self.err(field, format!("is {v} (must be > 0{unit})"), fix))
         }
     }
 
@@ -97,7 +99,14 @@ impl Ctx<'_> {
         }
     }
 
-    fn count(&self, field: &str, v: i64, min: i64, max: usize, fix: &str) -> Result<usize, WorldError> {
+    fn count(
+        &self,
+        field: &str,
+        v: i64,
+        min: i64,
+        max: usize,
+        fix: &str,
+    ) -> Result<usize, WorldError> {
         match usize::try_from(v) {
             Ok(n) if v >= min && n <= max => Ok(n),
             _ if v < min => Err(self.err(field, format!("is {v} (must be at least {min})"), fix)),
@@ -116,7 +125,12 @@ fn fmt_pt(p: Vec2) -> String {
     format!("({}, {})", p.0, p.1)
 }
 
-fn check_obstacle(ctx: &Ctx<'_>, i: usize, o: &ObstacleSpec, arena: &Arena) -> Result<Obstacle, WorldError> {
+fn check_obstacle(
+    ctx: &Ctx<'_>,
+    i: usize,
+    o: &ObstacleSpec,
+    arena: &Arena,
+) -> Result<Obstacle, WorldError> {
     let f = |s: &str| format!("obstacles[{i}].{s}");
     let obstacle = match o {
         ObstacleSpec::Rect { min, max } => {
@@ -137,7 +151,12 @@ fn check_obstacle(ctx: &Ctx<'_>, i: usize, o: &ObstacleSpec, arena: &Arena) -> R
         }
         ObstacleSpec::Circle { center, radius } => {
             let center = ctx.point(&f("center"), *center)?;
-            let radius = ctx.positive(&f("radius"), *radius, "metres", "give the circle a positive radius")?;
+            let radius = ctx.positive(
+                &f("radius"),
+                *radius,
+                "metres",
+                "give the circle a positive radius",
+            )?;
             Obstacle::Circle { center, radius }
         }
         ObstacleSpec::Polygon { points } => {
@@ -162,9 +181,7 @@ fn check_obstacle(ctx: &Ctx<'_>, i: usize, o: &ObstacleSpec, arena: &Arena) -> R
                     }
                 }
             }
-            let (lo, hi) = bbox(points);
-            let scale = (hi.0 - lo.0).max(hi.1 - lo.1);
-            if polygon_area(points).abs() <= 1e-9 * scale * scale {
+            if collinear(points) {
                 return Err(ctx.err(
                     &f("points"),
                     "has zero area (its vertices are collinear)",
@@ -187,18 +204,34 @@ fn check_obstacle(ctx: &Ctx<'_>, i: usize, o: &ObstacleSpec, arena: &Arena) -> R
                 points: points.clone(),
             }
         }
-        ObstacleSpec::Wall { from, to, thickness } => {
+        ObstacleSpec::Wall {
+            from,
+            to,
+            thickness,
+        } => {
             let from = ctx.point(&f("from"), *from)?;
             let to = ctx.point(&f("to"), *to)?;
             if from == to {
                 return Err(ctx.err(
                     &f("to"),
-                    format!("equals from {} (a wall needs a positive length)", fmt_pt(from)),
+                    format!(
+                        "equals from {} (a wall needs a positive length)",
+                        fmt_pt(from)
+                    ),
                     "move one end, or use a Circle for a round pillar",
                 ));
             }
-            let thickness = ctx.positive(&f("thickness"), *thickness, "metres", "give the wall a positive thickness, e.g. 0.1")?;
-            Obstacle::Wall { from, to, thickness }
+            let thickness = ctx.positive(
+                &f("thickness"),
+                *thickness,
+                "metres",
+                "give the wall a positive thickness, e.g. 0.1",
+            )?;
+            Obstacle::Wall {
+                from,
+                to,
+                thickness,
+            }
         }
     };
     // A wall's centre line must be in the arena; its half-thickness may overhang a side.
@@ -225,10 +258,50 @@ fn check_obstacle(ctx: &Ctx<'_>, i: usize, o: &ObstacleSpec, arena: &Arena) -> R
     Ok(obstacle)
 }
 
+/// Whether all points lie on one line (within a tolerance relative to their spread).
+fn collinear(points: &[Vec2]) -> bool {
+    let p0 = points[0];
+    let far = points.iter().copied().fold(p0, |f, p| {
+        if (p.0 - p0.0).hypot(p.1 - p0.1) > (f.0 - p0.0).hypot(f.1 - p0.1) {
+            p
+        } else {
+            f
+        }
+    });
+    let d = (far.0 - p0.0, far.1 - p0.1);
+    let len2 = d.0 * d.0 + d.1 * d.1;
+    points.iter().all(|p| {
+        let cross = d.0 * (p.1 - p0.1) - d.1 * (p.0 - p0.0);
+        cross.abs() <= 1e-9 * len2
+    })
+}
+
+/// A computed number, rounded to 6 significant digits for messages.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 fn bbox(points: &[Vec2]) -> (Vec2, Vec2) {
     points.iter().fold(
-        ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY)),
-        |(lo, hi), p| ((lo.0.min(p.0), lo.1.min(p.1)), (hi.0.max(p.0), hi.1.max(p.1))),
+        (
+            (f64::INFINITY, f64::INFINITY),
+            (f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                (lo.0.min(p.0), lo.1.min(p.1)),
+                (hi.0.max(p.0), hi.1.max(p.1)),
+            )
+        },
     )
 }
 
@@ -261,8 +334,18 @@ impl WorldSpec {
         // Arena.
         let a = self.arena.clone().unwrap_or_default();
         let arena = Arena {
-            width: ctx.positive("arena.width", a.width.unwrap_or(30.0), "metres", "give the arena a positive width, e.g. 30.0")?,
-            height: ctx.positive("arena.height", a.height.unwrap_or(10.0), "metres", "give the arena a positive height, e.g. 10.0")?,
+            width: ctx.positive(
+                "arena.width",
+                a.width.unwrap_or(30.0),
+                "metres",
+                "give the arena a positive width, e.g. 30.0",
+            )?,
+            height: ctx.positive(
+                "arena.height",
+                a.height.unwrap_or(10.0),
+                "metres",
+                "give the arena a positive height, e.g. 10.0",
+            )?,
         };
 
         // Obstacles.
@@ -277,10 +360,30 @@ impl WorldSpec {
         // Swarm.
         let d = SwarmParams::default();
         let s = self.swarm.clone().unwrap_or_default();
-        let agents = ctx.count("swarm.agents", s.agents.unwrap_or(d.agents as i64), 1, MAX_AGENTS, "use at least one agent (the paper uses 100)")?;
-        let speed = ctx.positive("swarm.speed", s.speed.unwrap_or(d.speed), "m/s", "give the agents a positive walking speed (the paper's v_m is 0.1)")?;
-        let detection_radius = ctx.positive("swarm.detection_radius", s.detection_radius.unwrap_or(d.detection_radius), "metres", "give a positive detection radius (the paper's r_d is 0.01)")?;
-        let landmark_fraction = ctx.finite("swarm.landmark_fraction", s.landmark_fraction.unwrap_or(d.landmark_fraction), "use a fraction in [0, 1), e.g. 0.1")?;
+        let agents = ctx.count(
+            "swarm.agents",
+            s.agents.unwrap_or(d.agents as i64),
+            1,
+            MAX_AGENTS,
+            "use at least one agent (the paper uses 100)",
+        )?;
+        let speed = ctx.positive(
+            "swarm.speed",
+            s.speed.unwrap_or(d.speed),
+            "m/s",
+            "give the agents a positive walking speed (the paper's v_m is 0.1)",
+        )?;
+        let detection_radius = ctx.positive(
+            "swarm.detection_radius",
+            s.detection_radius.unwrap_or(d.detection_radius),
+            "metres",
+            "give a positive detection radius (the paper's r_d is 0.01)",
+        )?;
+        let landmark_fraction = ctx.finite(
+            "swarm.landmark_fraction",
+            s.landmark_fraction.unwrap_or(d.landmark_fraction),
+            "use a fraction in [0, 1), e.g. 0.1",
+        )?;
         if !(0.0..1.0).contains(&landmark_fraction) {
             return Err(ctx.err(
                 "swarm.landmark_fraction",
@@ -296,27 +399,57 @@ impl WorldSpec {
                 "lower the fraction or add agents, so that at least one agent keeps walking",
             ));
         }
-        let body_radius = ctx.positive("swarm.body_radius", s.body_radius.unwrap_or(d.body_radius), "metres", "give the agents a positive body radius below half the detection radius")?;
+        let body_radius = ctx.positive(
+            "swarm.body_radius",
+            s.body_radius.unwrap_or(d.body_radius),
+            "metres",
+            "give the agents a positive body radius below half the detection radius",
+        )?;
         if body_radius >= detection_radius / 2.0 {
             return Err(ctx.err(
                 "swarm.body_radius",
                 format!(
                     "is {body_radius} m, not below half the detection radius ({} m): two bodies keep their centres at least {} m apart, so they could never come within r_d = {detection_radius} m and no encounter would ever be recorded",
-                    detection_radius / 2.0,
-                    2.0 * body_radius
+                    short(detection_radius / 2.0),
+                    short(2.0 * body_radius)
                 ),
                 "use a body radius below r_d / 2 (the default is 0.004 with r_d = 0.01), or raise swarm.detection_radius",
             ));
         }
-        let mean_run_length = ctx.positive("swarm.mean_run_length", s.mean_run_length.unwrap_or(d.mean_run_length), "metres", "give a positive mean run length λ, e.g. 1.0")?;
-        let stop_rate = ctx.non_negative("swarm.stop_rate", s.stop_rate.unwrap_or(d.stop_rate), "per second", "use 0 for no spontaneous stops, or a positive rate such as 0.01")?;
-        let mean_stop_duration = ctx.positive("swarm.mean_stop_duration", s.mean_stop_duration.unwrap_or(d.mean_stop_duration), "seconds", "give a positive mean stop duration, e.g. 5.0 (set stop_rate to 0 to disable stops)")?;
-        let comm_radius = ctx.positive("swarm.comm_radius", s.comm_radius.unwrap_or(d.comm_radius), "metres", "give a positive communication radius, e.g. 1.0")?;
+        let mean_run_length = ctx.positive(
+            "swarm.mean_run_length",
+            s.mean_run_length.unwrap_or(d.mean_run_length),
+            "metres",
+            "give a positive mean run length λ, e.g. 1.0",
+        )?;
+        let stop_rate = ctx.non_negative(
+            "swarm.stop_rate",
+            s.stop_rate.unwrap_or(d.stop_rate),
+            "per second",
+            "use 0 for no spontaneous stops, or a positive rate such as 0.01",
+        )?;
+        let mean_stop_duration = ctx.positive(
+            "swarm.mean_stop_duration",
+            s.mean_stop_duration.unwrap_or(d.mean_stop_duration),
+            "seconds",
+            "give a positive mean stop duration, e.g. 5.0 (set stop_rate to 0 to disable stops)",
+        )?;
+        let comm_radius = ctx.positive(
+            "swarm.comm_radius",
+            s.comm_radius.unwrap_or(d.comm_radius),
+            "metres",
+            "give a positive communication radius, e.g. 1.0",
+        )?;
         let placement = match s.placement.clone() {
             None => d.placement.clone(),
             Some(PlacementSpec::Window) => Placement::Window,
             Some(PlacementSpec::Disk { radius }) => Placement::Disk {
-                radius: ctx.positive("swarm.placement.radius", radius.unwrap_or(1.0), "metres", "give the placement disc a positive radius, e.g. 1.0, or use `Window`")?,
+                radius: ctx.positive(
+                    "swarm.placement.radius",
+                    radius.unwrap_or(1.0),
+                    "metres",
+                    "give the placement disc a positive radius, e.g. 1.0, or use `Window`",
+                )?,
             },
         };
         let swarm = SwarmParams {
@@ -334,12 +467,25 @@ impl WorldSpec {
 
         // Leader.
         let l = self.leader.clone().unwrap_or_default();
-        let lspeed = ctx.positive("leader.speed", l.speed.unwrap_or(0.005), "m/s", "give the leader a positive sweep speed (the paper's is 0.005)")?;
-        let window = ctx.positive("leader.window", l.window.unwrap_or(3.0), "metres", "give a positive window length l (the paper's is 3.0)")?;
+        let lspeed = ctx.positive(
+            "leader.speed",
+            l.speed.unwrap_or(0.005),
+            "m/s",
+            "give the leader a positive sweep speed (the paper's is 0.005)",
+        )?;
+        let window = ctx.positive(
+            "leader.window",
+            l.window.unwrap_or(3.0),
+            "metres",
+            "give a positive window length l (the paper's is 3.0)",
+        )?;
         if window > arena.width {
             return Err(ctx.err(
                 "leader.window",
-                format!("is {window} m, longer than the arena ({} m wide)", arena.width),
+                format!(
+                    "is {window} m, longer than the arena ({} m wide)",
+                    arena.width
+                ),
                 "use a window no longer than arena.width (the paper uses 3 m in a 30 m arena)",
             ));
         }
@@ -350,8 +496,8 @@ impl WorldSpec {
             if x < xlo - tol || x > xhi + tol {
                 return Err(ctx.err(
                     field,
-                    format!("is {x} m, outside [window/2, width − window/2] = [{xlo}, {xhi}] m, so D(t) would stick out of the arena"),
-                    format!("use an x between {xlo} and {xhi}, or leave it out for the default"),
+                    format!("is {x} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", short(xlo), short(xhi)),
+                    format!("use an x between {} and {}, or leave it out for the default", short(xlo), short(xhi)),
                 ));
             }
             Ok(x.clamp(xlo, xhi))
@@ -368,28 +514,70 @@ impl WorldSpec {
         // Time stepping.
         let sd = SimulationParams::default();
         let sim = self.simulation.clone().unwrap_or_default();
-        let dt = ctx.positive("simulation.dt", sim.dt.unwrap_or(sd.dt), "seconds", "give a positive time step, e.g. 0.02")?;
-        if 2.0 * speed * dt > detection_radius {
+        let dt = ctx.positive(
+            "simulation.dt",
+            sim.dt.unwrap_or(sd.dt),
+            "seconds",
+            "give a positive time step, e.g. 0.02",
+        )?;
+        // A relative tolerance keeps the boundary case `dt = r_d / (2·speed)` valid.
+        if 2.0 * speed * dt > detection_radius * (1.0 + 1e-9) {
             return Err(ctx.err(
                 "simulation.dt",
                 format!(
                     "is {dt} s: two agents walking at {speed} m/s towards each other close {} m per step, more than the detection radius {detection_radius} m, so encounters could be stepped over unseen",
-                    2.0 * speed * dt
+                    short(2.0 * speed * dt)
                 ),
-                format!("use dt ≤ r_d / (2·speed) = {} s", detection_radius / (2.0 * speed)),
+                format!("use dt ≤ r_d / (2·speed) = {} s", short(detection_radius / (2.0 * speed))),
             ));
         }
-        let dispersion_time = ctx.non_negative("simulation.dispersion_time", sim.dispersion_time.unwrap_or(sd.dispersion_time), "seconds", "use 0 to start the sweep at once, or a positive time such as 300")?;
-        let simulation = SimulationParams { dt, dispersion_time };
+        let dispersion_time = ctx.non_negative(
+            "simulation.dispersion_time",
+            sim.dispersion_time.unwrap_or(sd.dispersion_time),
+            "seconds",
+            "use 0 to start the sweep at once, or a positive time such as 300",
+        )?;
+        let simulation = SimulationParams {
+            dt,
+            dispersion_time,
+        };
 
         // Mapping.
         let md = MappingParams::default();
         let m = self.mapping.clone().unwrap_or_default();
-        let windows = ctx.count("mapping.windows", m.windows.unwrap_or(md.windows as i64), 1, MAX_WINDOWS, "use at least one window (the paper uses 4 to 6)")?;
-        let overlap = ctx.non_negative("mapping.overlap", m.overlap.unwrap_or(md.overlap), "seconds", "use a non-negative overlap Δt shorter than one window")?;
-        let cluster_cutoff = ctx.positive("mapping.cluster_cutoff", m.cluster_cutoff.unwrap_or(md.cluster_cutoff), "", "use a positive cut-off (the paper's c is 50)")?;
-        let subsample = ctx.count("mapping.subsample", m.subsample.unwrap_or(md.subsample as i64), 1, usize::MAX, "use at least one representative encounter per window, e.g. 400")?;
-        let neighbours = ctx.count("mapping.neighbours", m.neighbours.unwrap_or(md.neighbours as i64), 0, usize::MAX, "use a non-negative number of neighbours, e.g. 5")?;
+        let windows = ctx.count(
+            "mapping.windows",
+            m.windows.unwrap_or(md.windows as i64),
+            1,
+            MAX_WINDOWS,
+            "use at least one window (the paper uses 4 to 6)",
+        )?;
+        let overlap = ctx.non_negative(
+            "mapping.overlap",
+            m.overlap.unwrap_or(md.overlap),
+            "seconds",
+            "use a non-negative overlap Δt shorter than one window",
+        )?;
+        let cluster_cutoff = ctx.positive(
+            "mapping.cluster_cutoff",
+            m.cluster_cutoff.unwrap_or(md.cluster_cutoff),
+            "",
+            "use a positive cut-off (the paper's c is 50)",
+        )?;
+        let subsample = ctx.count(
+            "mapping.subsample",
+            m.subsample.unwrap_or(md.subsample as i64),
+            1,
+            usize::MAX,
+            "use at least one representative encounter per window, e.g. 400",
+        )?;
+        let neighbours = ctx.count(
+            "mapping.neighbours",
+            m.neighbours.unwrap_or(md.neighbours as i64),
+            0,
+            usize::MAX,
+            "use a non-negative number of neighbours, e.g. 5",
+        )?;
         let method = match m.method {
             None | Some(MethodSpec::Paper) => MappingMethod::Paper,
         };
@@ -433,8 +621,8 @@ impl WorldSpec {
         if overlap >= window_duration {
             return Err(ctx.err(
                 "mapping.overlap",
-                format!("is {overlap} s, not shorter than one window ({window_duration} s = {total} s run / {windows} windows)"),
-                format!("use an overlap Δt below {window_duration} s, or fewer windows"),
+                format!("is {overlap} s, not shorter than one window ({} s = {} s run / {windows} windows)", short(window_duration), short(total)),
+                format!("use an overlap Δt below {} s, or fewer windows", short(window_duration)),
             ));
         }
 
@@ -500,8 +688,38 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
                 x + half,
                 if blockers.is_empty() { "the arena's sides".to_string() } else { blockers.join(", ") }
             ),
-            format!("open a gap wider than 2·swarm.body_radius = {} m somewhere in that window, or move the obstacles", 2.0 * body),
+            format!("open a gap wider than 2·swarm.body_radius = {} m somewhere in that window, or move the obstacles", short(2.0 * body)),
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_rounds_to_six_significant_digits() {
+        assert_eq!(short(0.01 / (2.0 * 0.1)), "0.05");
+        assert_eq!(short(2.0 * 0.1 * 0.06), "0.012");
+        assert_eq!(short(1425.0), "1425");
+        assert_eq!(short(28.5), "28.5");
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(1.0 / 3.0), "0.333333");
+    }
+
+    #[test]
+    fn collinearity() {
+        assert!(collinear(&[(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]));
+        assert!(collinear(&[(2.0, 2.0), (1.0, 1.0), (3.0, 3.0), (1.5, 1.5)]));
+        assert!(!collinear(&[(1.0, 1.0), (2.0, 2.0), (3.0, 3.1)]));
+    }
+
+    #[test]
+    fn landmark_count_rounds() {
+        assert_eq!(landmark_count(0.1, 100), 10);
+        assert_eq!(landmark_count(0.1, 4), 0);
+        assert_eq!(landmark_count(0.5, 1), 1);
+        assert_eq!(landmark_count(0.0, 7), 0);
+    }
 }

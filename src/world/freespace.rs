@@ -105,7 +105,8 @@ impl FreeSpaceRaster {
             .find(|&x| {
                 // Columns whose centre lies in [x − half, x + half].
                 let lo = ((x - half) / self.cx - 0.5).ceil().max(0.0) as usize;
-                let hi = (((x + half) / self.cx - 0.5).floor() + 1.0).clamp(0.0, self.nx as f64) as usize;
+                let hi = (((x + half) / self.cx - 0.5).floor() + 1.0).clamp(0.0, self.nx as f64)
+                    as usize;
                 lo < hi && prefix[hi] == prefix[lo]
             })
     }

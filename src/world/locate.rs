@@ -156,7 +156,9 @@ fn tokenize(text: &str) -> Vec<Token<'_>> {
 
 /// Index just past the value starting at `i`.
 fn skip_value(t: &[Token<'_>], mut i: usize) -> usize {
-    if i < t.len() && t[i].kind == Kind::Ident && matches!(t.get(i + 1), Some(x) if matches!(x.kind, Kind::Open(_)))
+    if i < t.len()
+        && t[i].kind == Kind::Ident
+        && matches!(t.get(i + 1), Some(x) if matches!(x.kind, Kind::Open(_)))
     {
         i += 1;
     }
@@ -189,7 +191,9 @@ fn walk(t: &[Token<'_>], mut i: usize, path: &[Step], best: (usize, usize)) -> (
     let Some(head) = path.first() else {
         return best;
     };
-    if i < t.len() && t[i].kind == Kind::Ident && matches!(t.get(i + 1), Some(x) if matches!(x.kind, Kind::Open(_)))
+    if i < t.len()
+        && t[i].kind == Kind::Ident
+        && matches!(t.get(i + 1), Some(x) if matches!(x.kind, Kind::Open(_)))
     {
         i += 1;
     }
@@ -199,7 +203,8 @@ fn walk(t: &[Token<'_>], mut i: usize, path: &[Step], best: (usize, usize)) -> (
     i += 1; // past the opening bracket
     let mut index = 0usize;
     while i < t.len() && t[i].kind != Kind::Close {
-        let is_field = t[i].kind == Kind::Ident && t.get(i + 1).map(|x| x.kind) == Some(Kind::Colon);
+        let is_field =
+            t[i].kind == Kind::Ident && t.get(i + 1).map(|x| x.kind) == Some(Kind::Colon);
         let value_start = if is_field { i + 2 } else { i };
         let hit = match head {
             Step::Field(name) => is_field && t[i].text == name,
@@ -260,7 +265,7 @@ mod tests {
         assert_eq!(locate(TEXT, "obstacles"), Some((6, 5)));
         assert_eq!(locate(TEXT, "obstacles[0]"), Some((7, 9)));
         assert_eq!(locate(TEXT, "obstacles[1].radius"), Some((8, 36)));
-        assert_eq!(locate(TEXT, "obstacles[2].points[2]"), Some((9, 49)));
+        assert_eq!(locate(TEXT, "obstacles[2].points[2]"), Some((9, 50)));
         assert_eq!(locate(TEXT, "swarm.agents"), Some((11, 13)));
     }
 

@@ -22,13 +22,11 @@ pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;
 pub use geometry::{
-    point_in_polygon, polygon_area, polygon_self_intersection, segment_distance,
-    segments_intersect,
+    point_in_polygon, polygon_area, polygon_self_intersection, segment_distance, segments_intersect,
 };
 pub use locate::locate;
 pub use spec::{
-    ArenaSpec, LeaderSpec, MappingSpec, MethodSpec, ObstacleSpec, PlacementSpec,
-    SETTING_PATHS, SimulationSpec, SpecOrigin, SwarmSpec, WorldSpec, apply_assignment,
-    apply_override, parse_str,
+    ArenaSpec, LeaderSpec, MappingSpec, MethodSpec, ObstacleSpec, PlacementSpec, SETTING_PATHS,
+    SimulationSpec, SpecOrigin, SwarmSpec, WorldSpec, apply_assignment, apply_override, parse_str,
 };
 pub use types::*;

@@ -34,7 +34,11 @@ pub enum ObstacleSpec {
     /// `Polygon(points: [(x, y), ...])`, metres, a simple polygon in either orientation.
     Polygon { points: Vec<Vec2> },
     /// `Wall(from: (x, y), to: (x, y), thickness: t)`, metres.
-    Wall { from: Vec2, to: Vec2, thickness: f64 },
+    Wall {
+        from: Vec2,
+        to: Vec2,
+        thickness: f64,
+    },
 }
 
 /// `placement: Disk(radius: 1.0)` or `placement: Window`.
@@ -256,7 +260,11 @@ pub const SETTING_PATHS: &[&str] = &[
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
-fn put<T: DeserializeOwned>(slot: &mut Option<T>, path: &str, value: &str) -> Result<(), WorldError> {
+fn put<T: DeserializeOwned>(
+    slot: &mut Option<T>,
+    path: &str,
+    value: &str,
+) -> Result<(), WorldError> {
     let v = ron_options()
         .from_str(value)
         .map_err(|e| WorldError::BadSetting {
@@ -411,7 +419,10 @@ mod tests {
         assert_eq!(edit_distance("kitten", "sitting"), 3);
         assert_eq!(edit_distance("", "abc"), 3);
         assert_eq!(edit_distance("abc", "abc"), 0);
-        assert_eq!(suggestion("detection_radiu", &["detection_radius", "speed"]), " (did you mean `detection_radius`?)");
+        assert_eq!(
+            suggestion("detection_radiu", &["detection_radius", "speed"]),
+            " (did you mean `detection_radius`?)"
+        );
         assert_eq!(suggestion("zzz", &["detection_radius", "speed"]), "");
     }
 
