@@ -199,7 +199,7 @@ fn explain(code: &ron::Error) -> String {
             format!("the field `{field}` is given twice; keep only one")
         }
         E::Eof => "unexpected end of the file; a closing bracket is probably missing".into(),
-        E::ExpectedComma => "expected a comma between two entries".into(),
+        E::ExpectedComma => "expected a comma here, between the previous entry and this one".into(),
         other => format!("{other} (see docs/world-format.md for the format)"),
     }
 }
