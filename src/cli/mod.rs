@@ -1,6 +1,7 @@
 //! Subcommands. Each lives in its own file and returns `Result<(), Failure>`; the exit
 //! code comes from the failure's kind, never from a panic.
 
+mod check;
 mod persistence;
 
 use clap::{Parser, Subcommand};
@@ -39,6 +40,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Validate a world file and print a short summary.
+    Check(check::CheckArgs),
     /// Vietoris–Rips persistence diagram (H0, H1) of a CSV of points or distances.
     Persistence(persistence::PersistenceArgs),
 }
@@ -46,6 +49,7 @@ enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: Result<(), Failure> = match cli.command {
+        Command::Check(args) => check::run(&args),
         Command::Persistence(a) => persistence::run(a),
     };
     match result {

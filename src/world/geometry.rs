@@ -44,6 +44,86 @@ pub fn point_in_polygon(p: Vec2, poly: &[Vec2]) -> bool {
     inside
 }
 
+/// Signed area of a polygon (shoelace formula), m²: positive when counter-clockwise.
+pub fn polygon_area(poly: &[Vec2]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a.0 * b.1 - b.0 * a.1
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Orientation of `c` relative to the directed line `a → b`: `1` left, `-1` right, `0`
+/// collinear (within a tolerance relative to the coordinates' magnitude).
+fn orientation(a: Vec2, b: Vec2, c: Vec2) -> i8 {
+    let cross = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
+    let scale = [a.0, a.1, b.0, b.1, c.0, c.1]
+        .iter()
+        .fold(1.0f64, |m, v| m.max(v.abs()));
+    let eps = 1e-12 * scale * scale;
+    if cross > eps {
+        1
+    } else if cross < -eps {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether `c`, known collinear with `[a, b]`, lies within the segment's bounding box.
+fn on_segment(a: Vec2, b: Vec2, c: Vec2) -> bool {
+    c.0 >= a.0.min(b.0) && c.0 <= a.0.max(b.0) && c.1 >= a.1.min(b.1) && c.1 <= a.1.max(b.1)
+}
+
+/// Whether the closed segments `[a, b]` and `[c, d]` share a point (touching counts).
+pub fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
+    let (o1, o2) = (orientation(a, b, c), orientation(a, b, d));
+    let (o3, o4) = (orientation(c, d, a), orientation(c, d, b));
+    if o1 != o2 && o3 != o4 && o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0 {
+        return true;
+    }
+    (o1 == 0 && on_segment(a, b, c))
+        || (o2 == 0 && on_segment(a, b, d))
+        || (o3 == 0 && on_segment(c, d, a))
+        || (o4 == 0 && on_segment(c, d, b))
+}
+
+/// The first pair of edges `(i, j)` (edge `i` runs from vertex `i` to `i + 1`) of the
+/// closed polygon that meet although they should not: non-adjacent edges that share a
+/// point, or adjacent edges that fold back over each other. `None` for a simple polygon.
+/// Brute force over all pairs, O(n²), fine for hand-written obstacles.
+pub fn polygon_self_intersection(poly: &[Vec2]) -> Option<(usize, usize)> {
+    let n = poly.len();
+    if n < 3 {
+        return None;
+    }
+    let edge = |i: usize| (poly[i], poly[(i + 1) % n]);
+    for i in 0..n {
+        for j in i + 1..n {
+            let (a, b) = edge(i);
+            let (c, d) = edge(j);
+            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+            if adjacent {
+                // They share one vertex; they overlap only if the far vertex of one lies on
+                // the other, collinear and inside it (a spike folding back).
+                let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                let folds = orientation(p, shared, q) == 0
+                    && ((q.0 - shared.0) * (p.0 - shared.0) + (q.1 - shared.1) * (p.1 - shared.1))
+                        > 0.0;
+                if folds {
+                    return Some((i, j));
+                }
+            } else if segments_intersect(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
 impl Obstacle {
     /// Signed distance from `p` to the obstacle's solid, metres: positive outside,
     /// zero on the boundary, negative inside (minus the depth to the boundary).
@@ -72,6 +152,11 @@ impl Obstacle {
                 thickness,
             } => segment_distance(p, *from, *to) - thickness / 2.0,
         }
+    }
+
+    /// Unsigned distance from `p` to the obstacle's solid, metres: zero inside or on it.
+    pub fn distance(&self, p: Vec2) -> f64 {
+        self.signed_distance(p).max(0.0)
     }
 
     /// Axis-aligned bounding box `(min, max)` of the solid.
@@ -177,5 +262,123 @@ mod tests {
         assert!(!w.is_free((0.05, 1.0), 0.1));
         assert!(!w.is_free((5.0, 3.45), 0.1));
         assert!(w.is_free((5.0, 3.7), 0.1));
+    }
+
+    /// Oracle for segment intersection on small integer coordinates: solve
+    /// a + s(b − a) = c + t(d − c) exactly in i64 (Cramer's rule), with the collinear
+    /// case settled by projecting onto the common line.
+    fn intersect_oracle(a: (i64, i64), b: (i64, i64), c: (i64, i64), d: (i64, i64)) -> bool {
+        let r = (b.0 - a.0, b.1 - a.1);
+        let q = (d.0 - c.0, d.1 - c.1);
+        let w = (c.0 - a.0, c.1 - a.1);
+        let den = r.0 * q.1 - r.1 * q.0;
+        if den != 0 {
+            // s = (w × q) / den, t = (w × r) / den, both in [0, 1].
+            let sn = w.0 * q.1 - w.1 * q.0;
+            let tn = w.0 * r.1 - w.1 * r.0;
+            let within = |n: i64| {
+                if den > 0 {
+                    0 <= n && n <= den
+                } else {
+                    den <= n && n <= 0
+                }
+            };
+            return within(sn) && within(tn);
+        }
+        if w.0 * r.1 - w.1 * r.0 != 0 {
+            return false; // parallel, distinct lines
+        }
+        // Collinear (or degenerate): compare intervals along the dominant axis, or points.
+        let key = |p: (i64, i64)| if r.0 != 0 || q.0 != 0 { p.0 } else { p.1 };
+        if r == (0, 0) && q == (0, 0) {
+            return a == c;
+        }
+        if r == (0, 0) {
+            let cross = (a.0 - c.0) * q.1 - (a.1 - c.1) * q.0;
+            return cross == 0 && key(a) >= key(c).min(key(d)) && key(a) <= key(c).max(key(d));
+        }
+        if q == (0, 0) {
+            let cross = (c.0 - a.0) * r.1 - (c.1 - a.1) * r.0;
+            return cross == 0 && key(c) >= key(a).min(key(b)) && key(c) <= key(a).max(key(b));
+        }
+        key(a).max(key(b)) >= key(c).min(key(d)) && key(c).max(key(d)) >= key(a).min(key(b))
+    }
+
+    #[test]
+    fn segment_intersection_matches_exact_oracle() {
+        // Every segment pair on a 4 × 4 grid would be 65k² pairs; a deterministic
+        // pseudo-random walk over them covers crossings, touchings and collinear overlaps.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % 4) as i64
+        };
+        for _ in 0..200_000 {
+            let p: Vec<(i64, i64)> = (0..4).map(|_| (next(), next())).collect();
+            let f = |q: (i64, i64)| (q.0 as f64, q.1 as f64);
+            assert_eq!(
+                segments_intersect(f(p[0]), f(p[1]), f(p[2]), f(p[3])),
+                intersect_oracle(p[0], p[1], p[2], p[3]),
+                "{p:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn polygon_area_closed_forms() {
+        let sq = [(0.0, 0.0), (2.0, 0.0), (2.0, 3.0), (0.0, 3.0)];
+        assert_eq!(polygon_area(&sq), 6.0);
+        let cw: Vec<Vec2> = sq.iter().rev().copied().collect();
+        assert_eq!(polygon_area(&cw), -6.0);
+        let l = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ];
+        assert_eq!(polygon_area(&l), 3.0);
+    }
+
+    #[test]
+    fn simple_polygons_are_recognised() {
+        let l = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ];
+        assert_eq!(polygon_self_intersection(&l), None);
+        let tri = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+        assert_eq!(polygon_self_intersection(&tri), None);
+        // Bow tie: edge 0 (v0→v1) crosses edge 2 (v2→v3).
+        let bow = [(0.0, 0.0), (2.0, 2.0), (2.0, 0.0), (0.0, 2.0)];
+        assert_eq!(polygon_self_intersection(&bow), Some((0, 2)));
+        // A vertex on a non-adjacent edge.
+        let pinch = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (2.0, 0.0), (0.0, 4.0)];
+        assert!(polygon_self_intersection(&pinch).is_some());
+        // A spike folding back over its own edge, including across the closing vertex.
+        let spike = [(1.0, 1.0), (3.0, 1.0), (2.0, 1.0), (2.0, 3.0)];
+        assert!(polygon_self_intersection(&spike).is_some());
+        let spike0 = [(2.0, 1.0), (2.0, 3.0), (1.0, 1.0), (3.0, 1.0)];
+        assert!(polygon_self_intersection(&spike0).is_some());
+        // Collinear consecutive vertices that continue straight on are fine.
+        let straight = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 1.0)];
+        assert_eq!(polygon_self_intersection(&straight), None);
+    }
+
+    #[test]
+    fn unsigned_distance_is_zero_inside() {
+        let c = Obstacle::Circle {
+            center: (0.0, 0.0),
+            radius: 1.0,
+        };
+        assert_eq!(c.distance((0.5, 0.0)), 0.0);
+        assert_eq!(c.distance((3.0, 0.0)), 2.0);
     }
 }

@@ -1,11 +1,32 @@
 //! Worlds: the arena, its obstacles and every parameter of a run (paper §"Problem
 //! Statement", §"Simulation Results").
 //!
-//! A world file is RON. Reading is two-step: the text is parsed into a raw spec, which
-//! `check()` turns into a validated [`World`]; the simulator accepts only a [`World`].
+//! A world file is RON (format in `docs/world-format.md`). Reading is two-step, as in
+//! linfa's checked parameters: [`parse_str`] turns the text into a raw [`WorldSpec`]
+//! (every field optional, unknown fields rejected with the list of valid ones, syntax
+//! errors at `file:line:col`); [`apply_override`] may then set fields by dotted path; and
+//! [`WorldSpec::check`] fills in the paper's defaults and validates every rule into a
+//! [`World`], the only type the simulator accepts. Semantic errors name the field path
+//! and, when the field is in the text, its `file:line:col`.
 
+mod check;
+mod error;
+mod freespace;
 mod geometry;
+mod locate;
+mod spec;
+mod summary;
 mod types;
 
-pub use geometry::{point_in_polygon, segment_distance};
+pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count};
+pub use error::WorldError;
+pub use freespace::FreeSpaceRaster;
+pub use geometry::{
+    point_in_polygon, polygon_area, polygon_self_intersection, segment_distance, segments_intersect,
+};
+pub use locate::locate;
+pub use spec::{
+    ArenaSpec, LeaderSpec, MappingSpec, MethodSpec, ObstacleSpec, PlacementSpec, SETTING_PATHS,
+    SimulationSpec, SpecOrigin, SwarmSpec, WorldSpec, apply_assignment, apply_override, parse_str,
+};
 pub use types::*;

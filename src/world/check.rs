@@ -1,0 +1,725 @@
+//! `WorldSpec::check`: defaults, then every validation rule, then the validated [`World`].
+//!
+//! Rules, in order (each error names the field path, the value, the rule and a fix):
+//! numbers finite and in range; obstacles well formed (rect `min < max`, positive radii and
+//! thickness, walls of positive length, polygons with ≥ 3 distinct vertices, non-zero area
+//! and no crossing edges — checked pairwise, O(n²) in the vertices) and inside the arena
+//! (touching is allowed; a wall's centre line must be inside, its thickness may overhang);
+//! swarm, leader, time step and mapping parameters consistent with each other (e.g.
+//! `2·speed·dt ≤ r_d` so no encounter is stepped over, windows longer than their
+//! overlap); finally free space for the agents, on a raster of at most 2 cm (see
+//! `freespace.rs`): the initial placement area must hold the agents, and every window
+//! D(t) the leader visits must contain free space.
+
+use super::error::WorldError;
+use super::freespace::FreeSpaceRaster;
+use super::geometry::polygon_self_intersection;
+use super::locate::locate;
+use super::spec::{MethodSpec, ObstacleSpec, PlacementSpec, SpecOrigin, WorldSpec};
+use super::types::*;
+
+/// Largest number of agents accepted (memory for the simulation stays modest).
+pub const MAX_AGENTS: usize = 1_000_000;
+/// Largest number of time steps in one run (dispersion plus sweep over `dt`).
+pub const MAX_STEPS: f64 = 1e9;
+/// Largest number of windows.
+pub const MAX_WINDOWS: usize = 10_000;
+
+/// Builds errors that point at a field of the spec.
+struct Ctx<'a> {
+    origin: &'a SpecOrigin,
+}
+
+impl Ctx<'_> {
+    fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> WorldError {
+        let name = if self.origin.name.is_empty() {
+            "<world>"
+        } else {
+            self.origin.name.as_str()
+        };
+        let by_override = self.origin.overrides.iter().rev().find(|(p, _)| {
+            field == p || field.starts_with(&format!("{p}.")) || field.starts_with(&format!("{p}["))
+        });
+        let location = if let Some((p, v)) = by_override {
+            format!("{name} (--set {p}={v})")
+        } else if let Some((line, col)) = self.origin.text.as_deref().and_then(|t| locate(t, field))
+        {
+            format!("{name}:{line}:{col}")
+        } else {
+            name.to_string()
+        };
+        WorldError::Invalid {
+            location,
+            field: field.to_string(),
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+
+    fn finite(&self, field: &str, v: f64, fix: &str) -> Result<f64, WorldError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("is {v} (must be a finite number)"), fix))
+        }
+    }
+
+    fn positive(&self, field: &str, v: f64, unit: &str, fix: &str) -> Result<f64, WorldError> {
+        self.finite(field, v, fix)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            let unit = if unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            Err(self.err(field, format!("is {v} (must be > 0{unit})"), fix))
+        }
+    }
+
+    fn non_negative(&self, field: &str, v: f64, unit: &str, fix: &str) -> Result<f64, WorldError> {
+        self.finite(field, v, fix)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("is {v} (must be ≥ 0 {unit})"), fix))
+        }
+    }
+
+    fn point(&self, field: &str, p: Vec2) -> Result<Vec2, WorldError> {
+        if p.0.is_finite() && p.1.is_finite() {
+            Ok(p)
+        } else {
+            Err(self.err(
+                field,
+                format!("is ({}, {}) (coordinates must be finite numbers)", p.0, p.1),
+                "give finite coordinates in metres",
+            ))
+        }
+    }
+
+    fn count(
+        &self,
+        field: &str,
+        v: i64,
+        min: i64,
+        max: usize,
+        fix: &str,
+    ) -> Result<usize, WorldError> {
+        match usize::try_from(v) {
+            Ok(n) if v >= min && n <= max => Ok(n),
+            _ if v < min => Err(self.err(field, format!("is {v} (must be at least {min})"), fix)),
+            _ => Err(self.err(field, format!("is {v} (must be at most {max})"), fix)),
+        }
+    }
+}
+
+/// Number of landmarks the fraction gives among `agents` agents: `round(fraction · agents)`.
+pub fn landmark_count(fraction: f64, agents: usize) -> usize {
+    // Rounding a finite, in-range product: the cast cannot truncate meaningfully.
+    (fraction * agents as f64).round().max(0.0) as usize
+}
+
+fn fmt_pt(p: Vec2) -> String {
+    format!("({}, {})", p.0, p.1)
+}
+
+fn check_obstacle(
+    ctx: &Ctx<'_>,
+    i: usize,
+    o: &ObstacleSpec,
+    arena: &Arena,
+) -> Result<Obstacle, WorldError> {
+    let f = |s: &str| format!("obstacles[{i}].{s}");
+    let obstacle = match o {
+        ObstacleSpec::Rect { min, max } => {
+            let min = ctx.point(&f("min"), *min)?;
+            let max = ctx.point(&f("max"), *max)?;
+            if !(min.0 < max.0 && min.1 < max.1) {
+                return Err(ctx.err(
+                    &f("max"),
+                    format!(
+                        "is {} but min is {} (need min.x < max.x and min.y < max.y)",
+                        fmt_pt(max),
+                        fmt_pt(min)
+                    ),
+                    "give the lower-left corner as min and the upper-right one as max, with a positive width and height",
+                ));
+            }
+            Obstacle::Rect { min, max }
+        }
+        ObstacleSpec::Circle { center, radius } => {
+            let center = ctx.point(&f("center"), *center)?;
+            let radius = ctx.positive(
+                &f("radius"),
+                *radius,
+                "metres",
+                "give the circle a positive radius",
+            )?;
+            Obstacle::Circle { center, radius }
+        }
+        ObstacleSpec::Polygon { points } => {
+            if points.len() < 3 {
+                return Err(ctx.err(
+                    &f("points"),
+                    format!("has {} vertices (a polygon needs at least 3)", points.len()),
+                    "list at least three vertices in order along the boundary, or use a Wall for a segment",
+                ));
+            }
+            for (j, p) in points.iter().enumerate() {
+                ctx.point(&f(&format!("points[{j}]")), *p)?;
+            }
+            for j in 0..points.len() {
+                for k in 0..j {
+                    if points[j] == points[k] {
+                        return Err(ctx.err(
+                            &f(&format!("points[{j}]")),
+                            format!("repeats points[{k}] {} (vertices must be distinct)", fmt_pt(points[j])),
+                            "remove the repeated vertex; the polygon closes itself, so do not repeat the first vertex at the end",
+                        ));
+                    }
+                }
+            }
+            if collinear(points) {
+                return Err(ctx.err(
+                    &f("points"),
+                    "has zero area (its vertices are collinear)",
+                    "give the polygon some width, or use a Wall for a thin straight obstacle",
+                ));
+            }
+            if let Some((a, b)) = polygon_self_intersection(points) {
+                let n = points.len();
+                return Err(ctx.err(
+                    &f("points"),
+                    format!(
+                        "is self-intersecting: edge points[{a}]→points[{}] meets edge points[{b}]→points[{}]",
+                        (a + 1) % n,
+                        (b + 1) % n
+                    ),
+                    "list the vertices in order along the boundary (non-convex shapes are fine, crossing edges are not), or split it into several polygons",
+                ));
+            }
+            Obstacle::Polygon {
+                points: points.clone(),
+            }
+        }
+        ObstacleSpec::Wall {
+            from,
+            to,
+            thickness,
+        } => {
+            let from = ctx.point(&f("from"), *from)?;
+            let to = ctx.point(&f("to"), *to)?;
+            if from == to {
+                return Err(ctx.err(
+                    &f("to"),
+                    format!(
+                        "equals from {} (a wall needs a positive length)",
+                        fmt_pt(from)
+                    ),
+                    "move one end, or use a Circle for a round pillar",
+                ));
+            }
+            let thickness = ctx.positive(
+                &f("thickness"),
+                *thickness,
+                "metres",
+                "give the wall a positive thickness, e.g. 0.1",
+            )?;
+            Obstacle::Wall {
+                from,
+                to,
+                thickness,
+            }
+        }
+    };
+    // A wall's centre line must be in the arena; its half-thickness may overhang a side.
+    let (lo, hi) = match &obstacle {
+        Obstacle::Wall { from, to, .. } => bbox(&[*from, *to]),
+        other => other.bounding_box(),
+    };
+    let tol = 1e-9 * arena.width.max(arena.height);
+    if lo.0 < -tol || lo.1 < -tol || hi.0 > arena.width + tol || hi.1 > arena.height + tol {
+        let what = if matches!(obstacle, Obstacle::Wall { .. }) {
+            "its centre line spans"
+        } else {
+            "spans"
+        };
+        return Err(ctx.err(
+            &format!("obstacles[{i}]"),
+            format!(
+                "sticks out of the arena: {what} x {} to {}, y {} to {} m, but the arena is x 0 to {}, y 0 to {} m",
+                lo.0, hi.0, lo.1, hi.1, arena.width, arena.height
+            ),
+            "move or shrink it so it lies inside the arena (touching the sides is allowed)",
+        ));
+    }
+    Ok(obstacle)
+}
+
+/// Whether all points lie on one line (within a tolerance relative to their spread).
+fn collinear(points: &[Vec2]) -> bool {
+    let p0 = points[0];
+    let far = points.iter().copied().fold(p0, |f, p| {
+        if (p.0 - p0.0).hypot(p.1 - p0.1) > (f.0 - p0.0).hypot(f.1 - p0.1) {
+            p
+        } else {
+            f
+        }
+    });
+    let d = (far.0 - p0.0, far.1 - p0.1);
+    let len2 = d.0 * d.0 + d.1 * d.1;
+    points.iter().all(|p| {
+        let cross = d.0 * (p.1 - p0.1) - d.1 * (p.0 - p0.0);
+        cross.abs() <= 1e-9 * len2
+    })
+}
+
+/// A computed number, rounded to 6 significant digits for messages.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+fn bbox(points: &[Vec2]) -> (Vec2, Vec2) {
+    points.iter().fold(
+        (
+            (f64::INFINITY, f64::INFINITY),
+            (f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                (lo.0.min(p.0), lo.1.min(p.1)),
+                (hi.0.max(p.0), hi.1.max(p.1)),
+            )
+        },
+    )
+}
+
+impl WorldSpec {
+    /// Fills in the defaults and validates every rule, giving the [`World`] the
+    /// simulator and the mapping stages accept.
+    pub fn check(self) -> Result<World, WorldError> {
+        let ctx = Ctx {
+            origin: &self.origin,
+        };
+
+        // Name: explicit, else the file's stem.
+        let name = match &self.name {
+            Some(n) => n.clone(),
+            None => std::path::Path::new(&self.origin.name)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .filter(|s| !s.is_empty())
+                .unwrap_or("world")
+                .to_string(),
+        };
+        if name.trim().is_empty() || name.chars().any(char::is_control) {
+            return Err(ctx.err(
+                "name",
+                format!("is {name:?} (must be non-empty, without control characters)"),
+                "give the world a short printable name, e.g. \"scenario1\"",
+            ));
+        }
+
+        // Arena.
+        let a = self.arena.clone().unwrap_or_default();
+        let arena = Arena {
+            width: ctx.positive(
+                "arena.width",
+                a.width.unwrap_or(30.0),
+                "metres",
+                "give the arena a positive width, e.g. 30.0",
+            )?,
+            height: ctx.positive(
+                "arena.height",
+                a.height.unwrap_or(10.0),
+                "metres",
+                "give the arena a positive height, e.g. 10.0",
+            )?,
+        };
+
+        // Obstacles.
+        let obstacles = self
+            .obstacles
+            .iter()
+            .flatten()
+            .enumerate()
+            .map(|(i, o)| check_obstacle(&ctx, i, o, &arena))
+            .collect::<Result<Vec<_>, _>>()?;
+
+        // Swarm.
+        let d = SwarmParams::default();
+        let s = self.swarm.clone().unwrap_or_default();
+        let agents = ctx.count(
+            "swarm.agents",
+            s.agents.unwrap_or(d.agents as i64),
+            1,
+            MAX_AGENTS,
+            "use at least one agent (the paper uses 100)",
+        )?;
+        let speed = ctx.positive(
+            "swarm.speed",
+            s.speed.unwrap_or(d.speed),
+            "m/s",
+            "give the agents a positive walking speed (the paper's v_m is 0.1)",
+        )?;
+        let detection_radius = ctx.positive(
+            "swarm.detection_radius",
+            s.detection_radius.unwrap_or(d.detection_radius),
+            "metres",
+            "give a positive detection radius (the paper's r_d is 0.01)",
+        )?;
+        let landmark_fraction = ctx.finite(
+            "swarm.landmark_fraction",
+            s.landmark_fraction.unwrap_or(d.landmark_fraction),
+            "use a fraction in [0, 1), e.g. 0.1",
+        )?;
+        if !(0.0..1.0).contains(&landmark_fraction) {
+            return Err(ctx.err(
+                "swarm.landmark_fraction",
+                format!("is {landmark_fraction} (must be in [0, 1): a share of the agents, and some must keep walking)"),
+                "use a fraction such as the paper's 0.1",
+            ));
+        }
+        let landmarks = landmark_count(landmark_fraction, agents);
+        if landmark_fraction > 0.0 && landmarks >= agents {
+            return Err(ctx.err(
+                "swarm.landmark_fraction",
+                format!("is {landmark_fraction}, which makes {landmarks} landmark(s) out of {agents} agent(s) and leaves none walking"),
+                "lower the fraction or add agents, so that at least one agent keeps walking",
+            ));
+        }
+        let body_radius = ctx.positive(
+            "swarm.body_radius",
+            s.body_radius.unwrap_or(d.body_radius),
+            "metres",
+            "give the agents a positive body radius below half the detection radius",
+        )?;
+        if body_radius >= detection_radius / 2.0 {
+            return Err(ctx.err(
+                "swarm.body_radius",
+                format!(
+                    "is {body_radius} m, not below half the detection radius ({} m): two bodies keep their centres at least {} m apart, so they could never come within r_d = {detection_radius} m and no encounter would ever be recorded",
+                    short(detection_radius / 2.0),
+                    short(2.0 * body_radius)
+                ),
+                "use a body radius below r_d / 2 (the default is 0.004 with r_d = 0.01), or raise swarm.detection_radius",
+            ));
+        }
+        let mean_run_length = ctx.positive(
+            "swarm.mean_run_length",
+            s.mean_run_length.unwrap_or(d.mean_run_length),
+            "metres",
+            "give a positive mean run length λ, e.g. 1.0",
+        )?;
+        let stop_rate = ctx.non_negative(
+            "swarm.stop_rate",
+            s.stop_rate.unwrap_or(d.stop_rate),
+            "per second",
+            "use 0 for no spontaneous stops, or a positive rate such as 0.01",
+        )?;
+        let mean_stop_duration = ctx.positive(
+            "swarm.mean_stop_duration",
+            s.mean_stop_duration.unwrap_or(d.mean_stop_duration),
+            "seconds",
+            "give a positive mean stop duration, e.g. 5.0 (set stop_rate to 0 to disable stops)",
+        )?;
+        let comm_radius = ctx.positive(
+            "swarm.comm_radius",
+            s.comm_radius.unwrap_or(d.comm_radius),
+            "metres",
+            "give a positive communication radius, e.g. 1.0",
+        )?;
+        let placement = match s.placement.clone() {
+            None => d.placement.clone(),
+            Some(PlacementSpec::Window) => Placement::Window,
+            Some(PlacementSpec::Disk { radius }) => Placement::Disk {
+                radius: ctx.positive(
+                    "swarm.placement.radius",
+                    radius.unwrap_or(1.0),
+                    "metres",
+                    "give the placement disc a positive radius, e.g. 1.0, or use `Window`",
+                )?,
+            },
+        };
+        let swarm = SwarmParams {
+            agents,
+            speed,
+            detection_radius,
+            landmark_fraction,
+            body_radius,
+            mean_run_length,
+            stop_rate,
+            mean_stop_duration,
+            comm_radius,
+            placement,
+        };
+
+        // Leader.
+        let l = self.leader.clone().unwrap_or_default();
+        let lspeed = ctx.positive(
+            "leader.speed",
+            l.speed.unwrap_or(0.005),
+            "m/s",
+            "give the leader a positive sweep speed (the paper's is 0.005)",
+        )?;
+        let window = ctx.positive(
+            "leader.window",
+            l.window.unwrap_or(3.0),
+            "metres",
+            "give a positive window length l (the paper's is 3.0)",
+        )?;
+        if window > arena.width {
+            return Err(ctx.err(
+                "leader.window",
+                format!(
+                    "is {window} m, longer than the arena ({} m wide)",
+                    arena.width
+                ),
+                "use a window no longer than arena.width (the paper uses 3 m in a 30 m arena)",
+            ));
+        }
+        let (xlo, xhi) = (window / 2.0, arena.width - window / 2.0);
+        let tol = 1e-9 * arena.width;
+        let sweep_end = |field: &str, v: Option<f64>, default: f64| {
+            let x = ctx.finite(field, v.unwrap_or(default), "give an x in metres")?;
+            if x < xlo - tol || x > xhi + tol {
+                return Err(ctx.err(
+                    field,
+                    format!("is {x} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", short(xlo), short(xhi)),
+                    format!("use an x between {} and {}, or leave it out for the default", short(xlo), short(xhi)),
+                ));
+            }
+            Ok(x.clamp(xlo, xhi))
+        };
+        let start_x = sweep_end("leader.start_x", l.start_x, xlo)?;
+        let end_x = sweep_end("leader.end_x", l.end_x, xhi)?;
+        let leader = LeaderParams {
+            speed: lspeed,
+            window,
+            start_x,
+            end_x,
+        };
+
+        // Time stepping.
+        let sd = SimulationParams::default();
+        let sim = self.simulation.clone().unwrap_or_default();
+        let dt = ctx.positive(
+            "simulation.dt",
+            sim.dt.unwrap_or(sd.dt),
+            "seconds",
+            "give a positive time step, e.g. 0.02",
+        )?;
+        // A relative tolerance keeps the boundary case `dt = r_d / (2·speed)` valid.
+        if 2.0 * speed * dt > detection_radius * (1.0 + 1e-9) {
+            return Err(ctx.err(
+                "simulation.dt",
+                format!(
+                    "is {dt} s: two agents walking at {speed} m/s towards each other close {} m per step, more than the detection radius {detection_radius} m, so encounters could be stepped over unseen",
+                    short(2.0 * speed * dt)
+                ),
+                format!("use dt ≤ r_d / (2·speed) = {} s", short(detection_radius / (2.0 * speed))),
+            ));
+        }
+        let dispersion_time = ctx.non_negative(
+            "simulation.dispersion_time",
+            sim.dispersion_time.unwrap_or(sd.dispersion_time),
+            "seconds",
+            "use 0 to start the sweep at once, or a positive time such as 300",
+        )?;
+        let simulation = SimulationParams {
+            dt,
+            dispersion_time,
+        };
+
+        // Mapping.
+        let md = MappingParams::default();
+        let m = self.mapping.clone().unwrap_or_default();
+        let windows = ctx.count(
+            "mapping.windows",
+            m.windows.unwrap_or(md.windows as i64),
+            1,
+            MAX_WINDOWS,
+            "use at least one window (the paper uses 4 to 6)",
+        )?;
+        let overlap = ctx.non_negative(
+            "mapping.overlap",
+            m.overlap.unwrap_or(md.overlap),
+            "seconds",
+            "use a non-negative overlap Δt shorter than one window",
+        )?;
+        let cluster_cutoff = ctx.positive(
+            "mapping.cluster_cutoff",
+            m.cluster_cutoff.unwrap_or(md.cluster_cutoff),
+            "",
+            "use a positive cut-off (the paper's c is 50)",
+        )?;
+        let subsample = ctx.count(
+            "mapping.subsample",
+            m.subsample.unwrap_or(md.subsample as i64),
+            1,
+            usize::MAX,
+            "use at least one representative encounter per window, e.g. 400",
+        )?;
+        let neighbours = ctx.count(
+            "mapping.neighbours",
+            m.neighbours.unwrap_or(md.neighbours as i64),
+            0,
+            usize::MAX,
+            "use a non-negative number of neighbours, e.g. 5",
+        )?;
+        let method = match m.method {
+            None | Some(MethodSpec::Paper) => MappingMethod::Paper,
+        };
+        let mapping = MappingParams {
+            windows,
+            overlap,
+            cluster_cutoff,
+            subsample,
+            neighbours,
+            method,
+        };
+
+        let world = World {
+            name,
+            arena,
+            obstacles,
+            swarm,
+            leader,
+            simulation,
+            mapping,
+            seed: self.seed.unwrap_or(1),
+        };
+
+        // Durations.
+        let total = world.total_duration();
+        if total.is_nan() || total <= 0.0 || !total.is_finite() {
+            return Err(ctx.err(
+                "leader.end_x",
+                format!("is {end_x} m and the run lasts {total} s (dispersion {dispersion_time} s plus the sweep from x = {start_x} m)"),
+                "give the sweep a positive length (end_x ≠ start_x) or a positive simulation.dispersion_time",
+            ));
+        }
+        if total / dt > MAX_STEPS {
+            return Err(ctx.err(
+                "simulation.dt",
+                format!("is {dt} s, so the {total} s run needs {:.3e} steps (at most {MAX_STEPS:e} allowed)", total / dt),
+                "use a larger time step, a faster leader or a shorter sweep",
+            ));
+        }
+        let window_duration = total / windows as f64;
+        if overlap >= window_duration {
+            return Err(ctx.err(
+                "mapping.overlap",
+                format!("is {overlap} s, not shorter than one window ({} s = {} s run / {windows} windows)", short(window_duration), short(total)),
+                format!("use an overlap Δt below {} s, or fewer windows", short(window_duration)),
+            ));
+        }
+
+        check_free_space(&ctx, &world)?;
+        Ok(world)
+    }
+}
+
+/// Free space for the agents: the placement area must hold them, and every window the
+/// leader visits must contain some free space.
+fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
+    let body = world.swarm.body_radius;
+    let need = world.swarm.agents as f64 * (2.0 * body).powi(2);
+    let (xs, h) = (world.leader.start_x, world.arena.height);
+    let half = world.leader.window / 2.0;
+    match world.swarm.placement {
+        Placement::Disk { radius } => {
+            let free = FreeSpaceRaster::disc_free_area(world, (xs, h / 2.0), radius, body);
+            if free <= 0.0 {
+                return Err(ctx.err(
+                    "swarm.placement",
+                    format!("is a disc of radius {radius} m around ({xs}, {}) with no free space for an agent of body radius {body} m", h / 2.0),
+                    "enlarge the disc, use `Window`, or move leader.start_x or the obstacles",
+                ));
+            }
+            if free < need {
+                return Err(ctx.err(
+                    "swarm.placement",
+                    format!("is a disc of radius {radius} m around ({xs}, {}) with only {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", h / 2.0, world.swarm.agents),
+                    "enlarge the disc, use `Window`, or use fewer agents",
+                ));
+            }
+        }
+        Placement::Window => {}
+    }
+    let raster = FreeSpaceRaster::new(world, body);
+    if let Placement::Window = world.swarm.placement {
+        let free = raster.free_area_in_band(xs - half, xs + half);
+        if free < need.max(f64::MIN_POSITIVE) {
+            return Err(ctx.err(
+                "swarm.placement",
+                format!("is the initial window x {} to {} m, which has {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", xs - half, xs + half, world.swarm.agents),
+                "clear space in the first window, move leader.start_x, or use fewer agents",
+            ));
+        }
+    }
+    if let Some(x) = raster.first_blocked_window(world) {
+        let blockers: Vec<String> = world
+            .obstacles
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| {
+                let (lo, hi) = o.bounding_box();
+                hi.0 >= x - half && lo.0 <= x + half
+            })
+            .map(|(i, _)| format!("obstacles[{i}]"))
+            .collect();
+        return Err(ctx.err(
+            "obstacles",
+            format!(
+                "leave no free space for an agent of body radius {body} m in the leader's window around x = {x:.2} m (D(t) = x {:.2} to {:.2} m); it is blocked by {}",
+                x - half,
+                x + half,
+                if blockers.is_empty() { "the arena's sides".to_string() } else { blockers.join(", ") }
+            ),
+            format!("open a gap wider than 2·swarm.body_radius = {} m somewhere in that window, or move the obstacles", short(2.0 * body)),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_rounds_to_six_significant_digits() {
+        assert_eq!(short(0.01 / (2.0 * 0.1)), "0.05");
+        assert_eq!(short(2.0 * 0.1 * 0.06), "0.012");
+        assert_eq!(short(1425.0), "1425");
+        assert_eq!(short(28.5), "28.5");
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(1.0 / 3.0), "0.333333");
+    }
+
+    #[test]
+    fn collinearity() {
+        assert!(collinear(&[(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]));
+        assert!(collinear(&[(2.0, 2.0), (1.0, 1.0), (3.0, 3.0), (1.5, 1.5)]));
+        assert!(!collinear(&[(1.0, 1.0), (2.0, 2.0), (3.0, 3.1)]));
+    }
+
+    #[test]
+    fn landmark_count_rounds() {
+        assert_eq!(landmark_count(0.1, 100), 10);
+        assert_eq!(landmark_count(0.1, 4), 0);
+        assert_eq!(landmark_count(0.5, 1), 1);
+        assert_eq!(landmark_count(0.0, 7), 0);
+    }
+}

@@ -1,0 +1,441 @@
+//! The raw world spec: what a RON world file says, before any check. Every section and
+//! every field is optional; `check()` (in `check.rs`) fills in the defaults and validates.
+//!
+//! Parsing uses `ron` with the `implicit_some` extension, so `agents: 100` is accepted for
+//! an optional field, and `deny_unknown_fields` everywhere, so a misspelt field is an error
+//! that lists the valid ones. Overrides (`--set swarm.detection_radius=0.03`) act on this
+//! raw spec, so an overridden world is validated exactly like a written one.
+
+use super::error::WorldError;
+use super::types::Vec2;
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+
+/// `arena: (width: 30.0, height: 10.0)`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArenaSpec {
+    /// Metres along the sweep (default `30.0`).
+    #[serde(default)]
+    pub width: Option<f64>,
+    /// Metres (default `10.0`).
+    #[serde(default)]
+    pub height: Option<f64>,
+}
+
+/// One obstacle as written.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ObstacleSpec {
+    /// `Rect(min: (x, y), max: (x, y))`, metres.
+    Rect { min: Vec2, max: Vec2 },
+    /// `Circle(center: (x, y), radius: r)`, metres.
+    Circle { center: Vec2, radius: f64 },
+    /// `Polygon(points: [(x, y), ...])`, metres, a simple polygon in either orientation.
+    Polygon { points: Vec<Vec2> },
+    /// `Wall(from: (x, y), to: (x, y), thickness: t)`, metres.
+    Wall {
+        from: Vec2,
+        to: Vec2,
+        thickness: f64,
+    },
+}
+
+/// `placement: Disk(radius: 1.0)` or `placement: Window`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum PlacementSpec {
+    /// Disc centred on the leader's start at mid-height; radius in metres (default `1.0`).
+    Disk {
+        #[serde(default)]
+        radius: Option<f64>,
+    },
+    /// The whole initial window D(0).
+    Window,
+}
+
+/// `swarm: (...)`; see `docs/world-format.md` for units and defaults.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SwarmSpec {
+    pub agents: Option<i64>,
+    pub speed: Option<f64>,
+    pub detection_radius: Option<f64>,
+    pub landmark_fraction: Option<f64>,
+    pub body_radius: Option<f64>,
+    pub mean_run_length: Option<f64>,
+    pub stop_rate: Option<f64>,
+    pub mean_stop_duration: Option<f64>,
+    pub comm_radius: Option<f64>,
+    pub placement: Option<PlacementSpec>,
+}
+
+/// `leader: (...)`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LeaderSpec {
+    pub speed: Option<f64>,
+    pub window: Option<f64>,
+    pub start_x: Option<f64>,
+    pub end_x: Option<f64>,
+}
+
+/// `simulation: (...)`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimulationSpec {
+    pub dt: Option<f64>,
+    pub dispersion_time: Option<f64>,
+}
+
+/// `method: Paper`. Mirrors [`super::MappingMethod`]; a new method needs a variant here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum MethodSpec {
+    Paper,
+}
+
+/// `mapping: (...)`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MappingSpec {
+    pub windows: Option<i64>,
+    pub overlap: Option<f64>,
+    pub cluster_cutoff: Option<f64>,
+    pub subsample: Option<i64>,
+    pub neighbours: Option<i64>,
+    pub method: Option<MethodSpec>,
+}
+
+/// Where a spec came from: used to say `file:line:col` in errors.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpecOrigin {
+    /// File name (or other label) shown in messages.
+    pub name: String,
+    /// The RON text, used to locate fields; `None` for specs built in code.
+    pub text: Option<String>,
+    /// `(path, value)` of every override applied, in order.
+    pub overrides: Vec<(String, String)>,
+}
+
+/// A world as written: every section and field optional. Turn it into a validated
+/// [`super::World`] with [`WorldSpec::check`].
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WorldSpec {
+    pub name: Option<String>,
+    pub arena: Option<ArenaSpec>,
+    pub obstacles: Option<Vec<ObstacleSpec>>,
+    pub swarm: Option<SwarmSpec>,
+    pub leader: Option<LeaderSpec>,
+    pub simulation: Option<SimulationSpec>,
+    pub mapping: Option<MappingSpec>,
+    pub seed: Option<u64>,
+    #[serde(skip)]
+    pub origin: SpecOrigin,
+}
+
+fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+}
+
+/// Levenshtein distance, for "did you mean" suggestions.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// " (did you mean `x`?)" when one candidate is close to `found`.
+fn suggestion(found: &str, candidates: &[&str]) -> String {
+    candidates
+        .iter()
+        .map(|c| (edit_distance(found, c), *c))
+        .filter(|(d, c)| *d <= 2.max(c.len() / 3))
+        .min()
+        .map(|(_, c)| format!(" (did you mean `{c}`?)"))
+        .unwrap_or_default()
+}
+
+fn list(items: &[&str]) -> String {
+    items
+        .iter()
+        .map(|s| format!("`{s}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A user-facing message (what and how to fix) for a ron error.
+fn explain(code: &ron::Error) -> String {
+    use ron::Error as E;
+    match code {
+        E::NoSuchStructField {
+            expected, found, ..
+        } => format!(
+            "unknown field `{found}`{}; the valid fields here are {}",
+            suggestion(found, expected),
+            list(expected)
+        ),
+        E::NoSuchEnumVariant {
+            expected, found, ..
+        } => format!(
+            "unknown variant `{found}`{}; the valid variants here are {}",
+            suggestion(found, expected),
+            list(expected)
+        ),
+        E::MissingStructField { field, outer } => match outer {
+            Some(o) => format!("{o} needs the field `{field}`; add `{field}: ...`"),
+            None => format!("missing field `{field}`; add `{field}: ...`"),
+        },
+        E::DuplicateStructField { field, .. } => {
+            format!("the field `{field}` is given twice; keep only one")
+        }
+        E::Eof => "unexpected end of the file; a closing bracket is probably missing".into(),
+        E::ExpectedComma => "expected a comma here, between the previous entry and this one".into(),
+        other => format!("{other} (see docs/world-format.md for the format)"),
+    }
+}
+
+/// Parses RON `text` into a raw spec; `origin_name` (usually the file name) prefixes
+/// error positions: `worlds/x.ron:12:5: unknown field ...`.
+pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError> {
+    let mut spec: WorldSpec = ron_options()
+        .from_str(text)
+        .map_err(|e| WorldError::Syntax {
+            origin: origin_name.to_string(),
+            line: e.span.start.line,
+            col: e.span.start.col,
+            message: explain(&e.code),
+        })?;
+    spec.origin = SpecOrigin {
+        name: origin_name.to_string(),
+        text: Some(text.to_string()),
+        overrides: Vec::new(),
+    };
+    Ok(spec)
+}
+
+/// Every path accepted by [`apply_override`], besides `obstacles[i]`.
+pub const SETTING_PATHS: &[&str] = &[
+    "name",
+    "seed",
+    "arena",
+    "arena.width",
+    "arena.height",
+    "obstacles",
+    "swarm",
+    "swarm.agents",
+    "swarm.speed",
+    "swarm.detection_radius",
+    "swarm.landmark_fraction",
+    "swarm.body_radius",
+    "swarm.mean_run_length",
+    "swarm.stop_rate",
+    "swarm.mean_stop_duration",
+    "swarm.comm_radius",
+    "swarm.placement",
+    "leader",
+    "leader.speed",
+    "leader.window",
+    "leader.start_x",
+    "leader.end_x",
+    "simulation",
+    "simulation.dt",
+    "simulation.dispersion_time",
+    "mapping",
+    "mapping.windows",
+    "mapping.overlap",
+    "mapping.cluster_cutoff",
+    "mapping.subsample",
+    "mapping.neighbours",
+    "mapping.method",
+];
+
+/// Parses `value` as RON of the slot's type and stores it.
+fn put<T: DeserializeOwned>(
+    slot: &mut Option<T>,
+    path: &str,
+    value: &str,
+) -> Result<(), WorldError> {
+    let v = ron_options()
+        .from_str(value)
+        .map_err(|e| WorldError::BadSetting {
+            path: path.to_string(),
+            value: value.to_string(),
+            message: format!(
+                "the value does not parse: {}; write it as in a world file, e.g. `0.5`, `100`, `Window`, `(width: 20.0)`",
+                explain(&e.code)
+            ),
+        })?;
+    *slot = Some(v);
+    Ok(())
+}
+
+impl WorldSpec {
+    /// Sets one field by dotted path, e.g. `("swarm.detection_radius", "0.03")`,
+    /// `("mapping.windows", "6")`, `("seed", "4")`, `("obstacles[1]", "Circle(center: (5.0, 5.0), radius: 1.0)")`.
+    /// `value` is RON of the field's type (a bare word is accepted for `name`). A section
+    /// path (`swarm`) replaces the whole section. Unknown paths are an error listing the
+    /// valid ones.
+    pub fn set(&mut self, path: &str, value: &str) -> Result<(), WorldError> {
+        let p = path.trim();
+        let v = value.trim();
+        match p {
+            "name" => {
+                if put(&mut self.name, p, v).is_err() {
+                    self.name = Some(v.to_string());
+                }
+            }
+            "seed" => put(&mut self.seed, p, v)?,
+            "arena" => put(&mut self.arena, p, v)?,
+            "arena.width" => put(&mut self.arena.get_or_insert_default().width, p, v)?,
+            "arena.height" => put(&mut self.arena.get_or_insert_default().height, p, v)?,
+            "obstacles" => put(&mut self.obstacles, p, v)?,
+            "swarm" => put(&mut self.swarm, p, v)?,
+            "leader" => put(&mut self.leader, p, v)?,
+            "simulation" => put(&mut self.simulation, p, v)?,
+            "mapping" => put(&mut self.mapping, p, v)?,
+            _ if p.starts_with("obstacles[") => {
+                let index = p
+                    .strip_prefix("obstacles[")
+                    .and_then(|r| r.strip_suffix(']'))
+                    .and_then(|i| i.parse::<usize>().ok());
+                let count = self.obstacles.as_ref().map_or(0, Vec::len);
+                let Some(i) = index.filter(|i| *i < count) else {
+                    return Err(WorldError::BadSetting {
+                        path: path.to_string(),
+                        value: value.to_string(),
+                        message: format!(
+                            "the world has {count} obstacle(s), so use `obstacles[i]` with i from 0 to {}, or set the whole `obstacles` list",
+                            count.saturating_sub(1)
+                        ),
+                    });
+                };
+                let mut one = None;
+                put(&mut one, p, v)?;
+                if let (Some(list), Some(o)) = (self.obstacles.as_mut(), one) {
+                    list[i] = o;
+                }
+            }
+            _ => {
+                let (section, field) = p.split_once('.').unwrap_or((p, ""));
+                match section {
+                    "swarm" => {
+                        let s = self.swarm.get_or_insert_default();
+                        match field {
+                            "agents" => put(&mut s.agents, p, v)?,
+                            "speed" => put(&mut s.speed, p, v)?,
+                            "detection_radius" => put(&mut s.detection_radius, p, v)?,
+                            "landmark_fraction" => put(&mut s.landmark_fraction, p, v)?,
+                            "body_radius" => put(&mut s.body_radius, p, v)?,
+                            "mean_run_length" => put(&mut s.mean_run_length, p, v)?,
+                            "stop_rate" => put(&mut s.stop_rate, p, v)?,
+                            "mean_stop_duration" => put(&mut s.mean_stop_duration, p, v)?,
+                            "comm_radius" => put(&mut s.comm_radius, p, v)?,
+                            "placement" => put(&mut s.placement, p, v)?,
+                            _ => return Err(unknown_setting(path)),
+                        }
+                    }
+                    "leader" => {
+                        let s = self.leader.get_or_insert_default();
+                        match field {
+                            "speed" => put(&mut s.speed, p, v)?,
+                            "window" => put(&mut s.window, p, v)?,
+                            "start_x" => put(&mut s.start_x, p, v)?,
+                            "end_x" => put(&mut s.end_x, p, v)?,
+                            _ => return Err(unknown_setting(path)),
+                        }
+                    }
+                    "simulation" => {
+                        let s = self.simulation.get_or_insert_default();
+                        match field {
+                            "dt" => put(&mut s.dt, p, v)?,
+                            "dispersion_time" => put(&mut s.dispersion_time, p, v)?,
+                            _ => return Err(unknown_setting(path)),
+                        }
+                    }
+                    "mapping" => {
+                        let s = self.mapping.get_or_insert_default();
+                        match field {
+                            "windows" => put(&mut s.windows, p, v)?,
+                            "overlap" => put(&mut s.overlap, p, v)?,
+                            "cluster_cutoff" => put(&mut s.cluster_cutoff, p, v)?,
+                            "subsample" => put(&mut s.subsample, p, v)?,
+                            "neighbours" => put(&mut s.neighbours, p, v)?,
+                            "method" => put(&mut s.method, p, v)?,
+                            _ => return Err(unknown_setting(path)),
+                        }
+                    }
+                    _ => return Err(unknown_setting(path)),
+                }
+            }
+        }
+        self.origin.overrides.push((p.to_string(), v.to_string()));
+        Ok(())
+    }
+}
+
+fn unknown_setting(path: &str) -> WorldError {
+    let mut valid: Vec<&str> = SETTING_PATHS.to_vec();
+    valid.push("obstacles[i]");
+    let hint = suggestion(path.trim(), SETTING_PATHS);
+    WorldError::UnknownSetting {
+        path: format!("{}{hint}", path.trim()),
+        valid: valid.join(", "),
+    }
+}
+
+/// Sets one field of `spec` by dotted path (see [`WorldSpec::set`]); used by `--set`.
+pub fn apply_override(spec: &mut WorldSpec, path: &str, value: &str) -> Result<(), WorldError> {
+    spec.set(path, value)
+}
+
+/// Applies `PATH=VALUE` (as typed after `--set`) to `spec`.
+pub fn apply_assignment(spec: &mut WorldSpec, assignment: &str) -> Result<(), WorldError> {
+    match assignment.split_once('=') {
+        Some((path, value)) => spec.set(path, value),
+        None => Err(WorldError::BadSetting {
+            path: assignment.to_string(),
+            value: String::new(),
+            message: "expected PATH=VALUE, e.g. `swarm.detection_radius=0.03`".into(),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distance_is_levenshtein() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("abc", "abc"), 0);
+        assert_eq!(
+            suggestion("detection_radiu", &["detection_radius", "speed"]),
+            " (did you mean `detection_radius`?)"
+        );
+        assert_eq!(suggestion("zzz", &["detection_radius", "speed"]), "");
+    }
+
+    #[test]
+    fn every_listed_path_is_settable() {
+        for path in SETTING_PATHS {
+            let mut spec = WorldSpec::default();
+            // A value of the wrong shape must fail as a bad value, never as an unknown path.
+            match spec.set(path, "\"definitely not valid\" )") {
+                Err(WorldError::BadSetting { .. }) => {}
+                Ok(()) if *path == "name" => {}
+                other => panic!("{path}: {other:?}"),
+            }
+        }
+    }
+}

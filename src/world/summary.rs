@@ -1,0 +1,153 @@
+//! Loading a world from a file, the time windows of the mapping (paper §"Dynamic
+//! Topological Mapping", eq. for W_i), and the short summary `swarmmap check` prints.
+
+use super::check::landmark_count;
+use super::error::WorldError;
+use super::freespace::FreeSpaceRaster;
+use super::spec::{WorldSpec, parse_str};
+use super::types::{Obstacle, Placement, World};
+use std::fmt::Write as _;
+use std::path::Path;
+
+impl WorldSpec {
+    /// Reads and parses a world file (not yet checked; apply overrides, then `check`).
+    pub fn load(path: impl AsRef<Path>) -> Result<WorldSpec, WorldError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| WorldError::Read {
+            path: path.display().to_string(),
+            source,
+        })?;
+        parse_str(&text, &path.display().to_string())
+    }
+}
+
+impl World {
+    /// Reads, parses and checks a world file.
+    pub fn load(path: impl AsRef<Path>) -> Result<World, WorldError> {
+        WorldSpec::load(path)?.check()
+    }
+
+    /// Parses and checks RON `text`; `name` labels error positions (`name:line:col`)
+    /// and is the default world name (its file stem).
+    pub fn from_str_named(text: &str, name: &str) -> Result<World, WorldError> {
+        parse_str(text, name)?.check()
+    }
+
+    /// The mapping's time windows `W_i = [t_{i−1} − Δt/2, t_i + Δt/2]`, `i = 1..N`, with
+    /// `t_i = i·T/N` evenly spaced over the whole run `[0, T]` (T = dispersion + sweep)
+    /// and clipped to it, so that they cover `[0, T]` (paper §"Dynamic Topological
+    /// Mapping"). Seconds.
+    pub fn window_spans(&self) -> Vec<(f64, f64)> {
+        let total = self.total_duration();
+        let n = self.mapping.windows.max(1);
+        let half = self.mapping.overlap / 2.0;
+        (1..=n)
+            .map(|i| {
+                let t0 = (i - 1) as f64 * total / n as f64;
+                let t1 = i as f64 * total / n as f64;
+                ((t0 - half).max(0.0), (t1 + half).min(total))
+            })
+            .collect()
+    }
+
+    /// The x-range in metres covered by D(t) over the time span `(t0, t1)`: the union of
+    /// the windows the leader passes through.
+    pub fn span_domain(&self, span: (f64, f64)) -> (f64, f64) {
+        let (a, b) = (self.domain(span.0), self.domain(span.1));
+        (a.0.min(b.0), a.1.max(b.1))
+    }
+
+    /// A short human-readable summary: arena, obstacles, swarm, sweep, windows.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let kinds = ["Rect", "Circle", "Polygon", "Wall"];
+        let mut counts = [0usize; 4];
+        for o in &self.obstacles {
+            counts[match o {
+                Obstacle::Rect { .. } => 0,
+                Obstacle::Circle { .. } => 1,
+                Obstacle::Polygon { .. } => 2,
+                Obstacle::Wall { .. } => 3,
+            }] += 1;
+        }
+        let by_kind: Vec<String> = kinds
+            .iter()
+            .zip(counts)
+            .filter(|(_, c)| *c > 0)
+            .map(|(k, c)| format!("{c} {k}"))
+            .collect();
+        let sw = &self.swarm;
+        let landmarks = landmark_count(sw.landmark_fraction, sw.agents);
+        let placement = match sw.placement {
+            Placement::Disk { radius } => format!("disc of radius {radius} m"),
+            Placement::Window => "initial window".to_string(),
+        };
+        let raster = FreeSpaceRaster::new(self, sw.body_radius);
+        let area = self.arena.width * self.arena.height;
+        let _ = writeln!(s, "world      {}", self.name);
+        let _ = writeln!(
+            s,
+            "arena      {} m × {} m (x along the sweep), free for agent centres: {:.1} % in {} connected region(s) ({:.0} mm raster)",
+            self.arena.width,
+            self.arena.height,
+            100.0 * raster.free_area() / area,
+            raster.components(),
+            1000.0 * raster.cx.max(raster.cy)
+        );
+        let _ = writeln!(
+            s,
+            "obstacles  {}{}",
+            self.obstacles.len(),
+            if by_kind.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", by_kind.join(", "))
+            }
+        );
+        let _ = writeln!(
+            s,
+            "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in a {}",
+            sw.agents,
+            landmarks,
+            100.0 * sw.landmark_fraction,
+            sw.detection_radius,
+            sw.speed,
+            sw.body_radius,
+            placement
+        );
+        let l = &self.leader;
+        let _ = writeln!(
+            s,
+            "leader     sweeps x {} → {} m at {} m/s, window l = {} m",
+            l.start_x, l.end_x, l.speed, l.window
+        );
+        let _ = writeln!(
+            s,
+            "time       dispersion {} s + sweep {} s = {} s, dt = {} s ({} steps)",
+            self.simulation.dispersion_time,
+            self.sweep_duration(),
+            self.total_duration(),
+            self.simulation.dt,
+            (self.total_duration() / self.simulation.dt).ceil()
+        );
+        let _ = writeln!(
+            s,
+            "windows    {} with overlap Δt = {} s:",
+            self.mapping.windows, self.mapping.overlap
+        );
+        for (i, span) in self.window_spans().iter().enumerate() {
+            let (x0, x1) = self.span_domain(*span);
+            let _ = writeln!(
+                s,
+                "  W{:<3} t {:>9.1} – {:>9.1} s   D covers x {:>6.2} – {:>6.2} m",
+                i + 1,
+                span.0,
+                span.1,
+                x0,
+                x1
+            );
+        }
+        let _ = write!(s, "seed       {}", self.seed);
+        s
+    }
+}

@@ -1,0 +1,115 @@
+//! `swarmmap check` as a black box: summary on success, the error and status 2 otherwise.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+fn swarmmap() -> Command {
+    Command::cargo_bin("swarmmap").expect("binary built")
+}
+
+#[test]
+fn check_prints_a_summary_of_each_scenario() {
+    for (file, windows, obstacles) in [
+        ("worlds/scenario1.ron", 4, "3 (1 Rect, 1 Circle, 1 Polygon)"),
+        ("worlds/scenario2.ron", 6, "1 (1 Rect)"),
+        ("worlds/scenario3.ron", 5, "6 (2 Rect, 2 Circle, 2 Polygon)"),
+    ] {
+        swarmmap()
+            .args(["check", file])
+            .assert()
+            .success()
+            .stdout(predicate::str::contains(format!("obstacles  {obstacles}")))
+            .stdout(predicate::str::contains("30 m × 10 m"))
+            .stdout(predicate::str::contains("100 agents, 10 landmarks"))
+            .stdout(predicate::str::contains("r_d = 0.01 m"))
+            .stdout(predicate::str::contains("sweeps x 1.5 → 28.5 m"))
+            .stdout(predicate::str::contains("sweep 5400 s = 5700 s"))
+            .stdout(predicate::str::contains(format!(
+                "windows    {windows} with overlap Δt = 300 s"
+            )))
+            .stdout(predicate::str::contains(format!("W{windows} ")))
+            .stdout(predicate::str::contains(format!("W{} ", windows + 1)).not());
+    }
+}
+
+#[test]
+fn check_rejects_an_invalid_world_with_status_2() {
+    swarmmap()
+        .args(["check", "tests/fixtures/worlds/negative_radius.ron"])
+        .assert()
+        .code(2)
+        .stdout("")
+        .stderr(predicate::str::contains(
+            "tests/fixtures/worlds/negative_radius.ron:6:36: obstacles[1].radius is -1 (must be > 0 metres); give the circle a positive radius",
+        ));
+}
+
+#[test]
+fn check_reports_syntax_errors_with_position() {
+    swarmmap()
+        .args(["check", "tests/fixtures/worlds/unknown_field.ron"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("unknown_field.ron:4:"))
+        .stderr(predicate::str::contains("did you mean `detection_radius`?"))
+        .stderr(predicate::str::contains("`landmark_fraction`"));
+}
+
+#[test]
+fn check_a_missing_file_is_an_input_error() {
+    swarmmap()
+        .args(["check", "worlds/does-not-exist.ron"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "worlds/does-not-exist.ron: cannot read the world file",
+        ));
+}
+
+#[test]
+fn check_applies_overrides() {
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario1.ron",
+            "--set",
+            "mapping.windows=6",
+            "--set",
+            "swarm.agents=50",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("windows    6 with"))
+        .stdout(predicate::str::contains("50 agents, 5 landmarks"));
+    swarmmap()
+        .args(["check", "worlds/scenario1.ron", "--set", "mapping.window=6"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("did you mean `mapping.windows`?"));
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario1.ron",
+            "--set",
+            "simulation.dt=1.0",
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "(--set simulation.dt=1.0): simulation.dt is 1 s",
+        ));
+    swarmmap()
+        .args(["check", "worlds/scenario1.ron", "--set", "seed"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("expected PATH=VALUE"));
+}
+
+#[test]
+fn check_has_help() {
+    swarmmap()
+        .args(["check", "--help"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("--set <PATH=VALUE>"));
+}

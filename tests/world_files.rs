@@ -1,0 +1,218 @@
+//! The bundled worlds: every one is valid, and the topology their comments promise (β0
+//! components and β1 holes of the free space, globally and per window) is what an
+//! independent raster computation of the free space finds.
+
+use swarmmap::world::World;
+
+const ALL: &[&str] = &[
+    "scenario1",
+    "scenario2",
+    "scenario3",
+    "empty",
+    "corridor",
+    "pillars",
+    "nonconvex",
+    "touching",
+];
+
+fn load(name: &str) -> World {
+    World::load(format!("worlds/{name}.ron")).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// (β0, β1) of the free space inside the band `x0 ≤ x ≤ x1` (full height), on a 5 cm
+/// raster: β0 counts 4-connected free components, β1 counts 8-connected blocked
+/// components that touch neither the band's nor the arena's border (the dual
+/// connectivities make the two counts consistent on a grid).
+fn betti(world: &World, x0: f64, x1: f64) -> (usize, usize) {
+    let cell = 0.05;
+    let nx = ((x1 - x0) / cell).round() as usize;
+    let ny = (world.arena.height / cell).round() as usize;
+    let free: Vec<bool> = (0..nx * ny)
+        .map(|k| {
+            let (ix, iy) = (k / ny, k % ny);
+            world.is_free(
+                (x0 + (ix as f64 + 0.5) * cell, (iy as f64 + 0.5) * cell),
+                0.0,
+            )
+        })
+        .collect();
+    let components = |want: bool, diagonal: bool| -> (usize, usize) {
+        let mut seen = vec![false; nx * ny];
+        let (mut all, mut inner) = (0, 0);
+        for s in 0..nx * ny {
+            if free[s] != want || seen[s] {
+                continue;
+            }
+            all += 1;
+            let mut touches = false;
+            let mut stack = vec![s];
+            seen[s] = true;
+            while let Some(c) = stack.pop() {
+                let (ix, iy) = ((c / ny) as i64, (c % ny) as i64);
+                if ix == 0 || iy == 0 || ix == nx as i64 - 1 || iy == ny as i64 - 1 {
+                    touches = true;
+                }
+                for dx in -1i64..=1 {
+                    for dy in -1i64..=1 {
+                        if (dx == 0 && dy == 0) || (!diagonal && dx != 0 && dy != 0) {
+                            continue;
+                        }
+                        let (jx, jy) = (ix + dx, iy + dy);
+                        if jx < 0 || jy < 0 || jx >= nx as i64 || jy >= ny as i64 {
+                            continue;
+                        }
+                        let n = (jx as usize) * ny + jy as usize;
+                        if free[n] == want && !seen[n] {
+                            seen[n] = true;
+                            stack.push(n);
+                        }
+                    }
+                }
+            }
+            if !touches {
+                inner += 1;
+            }
+        }
+        (all, inner)
+    };
+    (components(true, false).0, components(false, true).1)
+}
+
+fn per_window(world: &World) -> Vec<(usize, usize)> {
+    world
+        .window_spans()
+        .into_iter()
+        .map(|span| {
+            let (x0, x1) = world.span_domain(span);
+            betti(world, x0, x1)
+        })
+        .collect()
+}
+
+#[test]
+fn every_bundled_world_is_valid() {
+    for name in ALL {
+        let w = load(name);
+        assert_eq!(w.name, *name);
+        assert_eq!((w.arena.width, w.arena.height), (30.0, 10.0));
+    }
+    assert!(std::path::Path::new("worlds/training").is_dir());
+}
+
+#[test]
+fn the_scenarios_use_the_papers_parameters() {
+    for (name, windows) in [("scenario1", 4), ("scenario2", 6), ("scenario3", 5)] {
+        let w = load(name);
+        assert_eq!(w.mapping.windows, windows, "{name}");
+        assert_eq!(w.swarm.agents, 100);
+        assert_eq!(w.swarm.landmark_fraction, 0.1);
+        assert_eq!(w.swarm.detection_radius, 0.01);
+        assert_eq!(w.swarm.speed, 0.1);
+        assert_eq!(w.leader.speed, 0.005);
+        assert_eq!(w.leader.window, 3.0);
+        assert_eq!(w.mapping.cluster_cutoff, 50.0);
+    }
+}
+
+#[test]
+fn scenario_obstacles_keep_clear_of_walls_and_each_other() {
+    for name in ["scenario1", "scenario2", "scenario3"] {
+        let w = load(name);
+        let boxes: Vec<_> = w.obstacles.iter().map(|o| o.bounding_box()).collect();
+        for (i, (lo, hi)) in boxes.iter().enumerate() {
+            assert!(
+                lo.0 >= 1.0 && lo.1 >= 1.0,
+                "{name} obstacle {i} near a wall"
+            );
+            assert!(
+                hi.0 <= w.arena.width - 1.0 && hi.1 <= w.arena.height - 1.0,
+                "{name} obstacle {i} near a wall"
+            );
+            for (j, (lo2, hi2)) in boxes.iter().enumerate().skip(i + 1) {
+                let gap = (lo2.0 - hi.0)
+                    .max(lo.0 - hi2.0)
+                    .max(lo2.1 - hi.1)
+                    .max(lo.1 - hi2.1);
+                assert!(
+                    gap >= 1.0,
+                    "{name} obstacles {i} and {j} only {gap} m apart"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn scenario1_features_each_fit_one_window() {
+    let w = load("scenario1");
+    for o in &w.obstacles {
+        let (lo, hi) = o.bounding_box();
+        assert!(hi.0 - lo.0 <= 1.5 && hi.1 - lo.1 <= 1.5);
+    }
+    assert_eq!(betti(&w, 0.0, 30.0), (1, 3));
+    assert_eq!(per_window(&w), vec![(1, 1), (1, 1), (1, 0), (1, 1)]);
+}
+
+#[test]
+fn scenario2_long_obstacle_splits_the_middle_windows() {
+    let w = load("scenario2");
+    let (lo, hi) = w.obstacles[0].bounding_box();
+    assert!(
+        hi.0 - lo.0 > 2.0 * w.leader.window,
+        "longer than any window"
+    );
+    assert_eq!(betti(&w, 0.0, 30.0), (1, 1));
+    assert_eq!(
+        per_window(&w),
+        vec![(1, 0), (1, 0), (1, 0), (2, 0), (2, 0), (1, 0)]
+    );
+    // Stitching regions: D(t_i) at the window boundaries t_i = i·T/N; the last three see
+    // the bar across the whole window, hence two connections.
+    let n = w.mapping.windows;
+    let stitch: Vec<usize> = (1..n)
+        .map(|i| {
+            let (x0, x1) = w.domain(i as f64 * w.total_duration() / n as f64);
+            betti(&w, x0, x1).0
+        })
+        .collect();
+    assert_eq!(stitch, vec![1, 1, 2, 2, 2]);
+}
+
+#[test]
+fn scenario3_features_are_shared_by_consecutive_windows() {
+    let w = load("scenario3");
+    assert_eq!(betti(&w, 0.0, 30.0), (1, 6));
+    assert_eq!(per_window(&w), vec![(1, 2); 5]);
+    // Four of the six lie wholly inside two consecutive windows' domains.
+    let domains: Vec<_> = w
+        .window_spans()
+        .into_iter()
+        .map(|s| w.span_domain(s))
+        .collect();
+    let shared = w
+        .obstacles
+        .iter()
+        .filter(|o| {
+            let (lo, hi) = o.bounding_box();
+            domains
+                .iter()
+                .filter(|(a, b)| lo.0 >= *a && hi.0 <= *b)
+                .count()
+                == 2
+        })
+        .count();
+    assert_eq!(shared, 4);
+}
+
+#[test]
+fn the_other_worlds_have_the_topology_their_comments_state() {
+    let w = load("empty");
+    assert_eq!(betti(&w, 0.0, 30.0), (1, 0));
+    assert_eq!(per_window(&w), vec![(1, 0); 4]);
+    let w = load("corridor");
+    assert_eq!(betti(&w, 0.0, 30.0), (1, 0));
+    assert_eq!(per_window(&w), vec![(3, 0), (3, 0), (1, 0), (1, 0)]);
+    assert_eq!(betti(&load("pillars"), 0.0, 30.0), (1, 24));
+    assert_eq!(betti(&load("nonconvex"), 0.0, 30.0), (1, 2));
+    assert_eq!(betti(&load("touching"), 0.0, 30.0), (1, 1));
+}
