@@ -24,13 +24,13 @@ pub struct MapConfig {
 }
 
 impl MapConfig {
-    /// The configuration a world asks for: its `mapping` section, the span from the end of
-    /// dispersion (landmarks are selected then) to the end of the sweep.
+    /// The configuration a world asks for: its `mapping` section over the whole run
+    /// `[0, T]`, dispersion included (paper: ∪ W_i = [0, T]).
     pub fn for_world(world: &World) -> Self {
         Self {
             windows: world.mapping.windows,
             overlap: world.mapping.overlap,
-            span: (world.simulation.dispersion_time, world.total_duration()),
+            span: (0.0, world.total_duration()),
             local: LocalParams::from_mapping(&world.mapping),
         }
     }

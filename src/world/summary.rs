@@ -38,16 +38,15 @@ impl World {
     /// and clipped to it, so that they cover `[0, T]` (paper §"Dynamic Topological
     /// Mapping"). Seconds.
     pub fn window_spans(&self) -> Vec<(f64, f64)> {
-        let total = self.total_duration();
-        let n = self.mapping.windows.max(1);
-        let half = self.mapping.overlap / 2.0;
-        (1..=n)
-            .map(|i| {
-                let t0 = (i - 1) as f64 * total / n as f64;
-                let t1 = i as f64 * total / n as f64;
-                ((t0 - half).max(0.0), (t1 + half).min(total))
-            })
-            .collect()
+        crate::mapping::windows::windows(
+            0.0,
+            self.total_duration(),
+            self.mapping.windows.max(1),
+            self.mapping.overlap,
+        )
+        .iter()
+        .map(|w| (w.start, w.end))
+        .collect()
     }
 
     /// The x-range in metres covered by D(t) over the time span `(t0, t1)`: the union of
