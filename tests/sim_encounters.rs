@@ -19,7 +19,7 @@ fn crowded(width: f64, agents: usize, duration: f64) -> World {
 
 #[test]
 fn encounters_match_brute_force_centre_distances() {
-    let mut w = crowded(1.5, 60, 60.0);
+    let mut w = crowded(1.5, 60, 120.0);
     w.obstacles.push(Obstacle::Circle {
         center: (0.75, 0.75),
         radius: 0.2,
@@ -92,7 +92,7 @@ fn encounters_match_brute_force_centre_distances() {
 
 #[test]
 fn halving_the_time_step_changes_the_encounter_count_by_less_than_5_percent() {
-    let base = crowded(3.0, 300, 400.0);
+    let base = crowded(2.5, 300, 400.0);
     let dt = base.simulation.dt;
     let mut counts = Vec::new();
     for (k, step) in [dt, dt / 2.0].into_iter().enumerate() {
@@ -103,7 +103,7 @@ fn halving_the_time_step_changes_the_encounter_count_by_less_than_5_percent() {
     }
     let change = (counts[1] - counts[0]).abs() / counts[1];
     eprintln!("encounters at dt, dt/2: {counts:?}; change {change}");
-    // Poisson noise of the difference is ~1.2 % at these counts; the bound is 5 %.
-    assert!(counts[1] > 8000.0, "too few encounters: {counts:?}");
+    // Poisson noise of the difference is ~1.7 % at these counts; the bound is 5 %.
+    assert!(counts[1] > 6000.0, "too few encounters: {counts:?}");
     assert!(change < 0.05, "counts {counts:?}: change {change}");
 }

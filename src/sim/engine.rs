@@ -5,13 +5,13 @@ use super::landmarks;
 use super::params::{
     AgentState, SimError, SimOptions, SimOutput, SimStats, TrajectorySample, Trajectories,
 };
-use super::physics::{RawEvent, Scene};
+use super::physics::{RawEvent, SIDES, Scene};
 use super::placement;
 use crate::log::{AgentId, Encounter, EncounterLog, StaticInterval, StaticReason};
 use crate::world::World;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -20,6 +20,11 @@ use std::time::Instant;
 /// from queueing behind an obstacle in single file.
 pub const RETURN_NOISE: f64 = PI / 3.0;
 
+/// Mean run length while returning, metres: a returning agent re-senses the leader's
+/// gradient this often, so that a turn away from an obstacle is a short detour rather
+/// than a full random-walk run away from the leader.
+pub const RETURN_RUN_LENGTH: f64 = 0.3;
+
 /// Interval of the leader's track in `leader.csv`, seconds (rounded to whole steps).
 pub const LEADER_INTERVAL: f64 = 1.0;
 
@@ -27,7 +32,22 @@ pub const LEADER_INTERVAL: f64 = 1.0;
 /// mean of the contact normals.
 const HEADING_TRIES: usize = 64;
 
+/// Gap under which a body counts as touching what Rapier reported near it, metres: the
+/// speculative contacts stop bodies at a gap of zero, up to f32 rounding.
+const TOUCH_GAP: f64 = 1e-4;
+
 type P = (f64, f64);
+
+/// What an agent's body can touch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Other {
+    /// Another agent, with a larger index.
+    Agent(u32),
+    /// `World::obstacles[k]`.
+    Obstacle(u32),
+    /// The arena's sides.
+    Sides,
+}
 
 struct Agent {
     state: AgentState,
@@ -121,19 +141,40 @@ impl Agent {
         }
     }
 
+    /// Draws the length of a new run for the agent's mode, metres.
+    fn new_run(&mut self, world: &World) {
+        let mean = if self.state == AgentState::Return {
+            RETURN_RUN_LENGTH.min(world.swarm.mean_run_length)
+        } else {
+            world.swarm.mean_run_length
+        };
+        self.run_left = exponential(&mut self.rng, mean);
+    }
+
     fn moving(&self) -> bool {
         matches!(self.state, AgentState::Walk | AgentState::Return)
     }
 }
 
-/// Outward unit normal of the nearest obstacle or arena side at `p`, by central
-/// differences of the exact clearance.
-fn obstacle_normal(world: &World, p: P) -> Option<P> {
+/// Outward unit normal of a signed distance `f` at `p`, by central differences.
+fn gradient(f: impl Fn(P) -> f64, p: P) -> Option<P> {
     let h = 1e-6;
-    let gx = world.clearance((p.0 + h, p.1)) - world.clearance((p.0 - h, p.1));
-    let gy = world.clearance((p.0, p.1 + h)) - world.clearance((p.0, p.1 - h));
+    let gx = f((p.0 + h, p.1)) - f((p.0 - h, p.1));
+    let gy = f((p.0, p.1 + h)) - f((p.0, p.1 - h));
     let len = gx.hypot(gy);
     (len > 0.0 && len.is_finite()).then(|| (gx / len, gy / len))
+}
+
+/// Gaps between a body of radius `r` at `p` and the arena's four sides, with the
+/// inward normals of the sides.
+fn side_gaps(world: &World, p: P, r: f64) -> [(f64, P); 4] {
+    let (w, h) = (world.arena.width, world.arena.height);
+    [
+        (p.0 - r, (1.0, 0.0)),
+        (w - p.0 - r, (-1.0, 0.0)),
+        (p.1 - r, (0.0, 1.0)),
+        (h - p.1 - r, (0.0, -1.0)),
+    ]
 }
 
 fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
@@ -211,6 +252,10 @@ struct Run<'w> {
     landmarks: Vec<usize>,
     landmarks_started: bool,
     open: HashMap<(u32, u32), (f64, [f64; 4])>,
+    /// Pairs Rapier reports within the contact prediction distance.
+    near: BTreeSet<(u32, Other)>,
+    /// Near pairs whose bodies touch (gap below [`TOUCH_GAP`]).
+    touching: BTreeSet<(u32, Other)>,
     log: EncounterLog,
     stats: SimStats,
     rng: ChaCha8Rng,
@@ -232,7 +277,7 @@ impl Run<'_> {
         a.state = AgentState::Walk;
         a.normals.clear();
         a.new_heading(p.0, leader_x);
-        a.run_left = exponential(&mut a.rng, self.world.swarm.mean_run_length);
+        a.new_run(self.world);
     }
 
     /// Mode changes at time `t` for agent `i` at `p`, before the step.
@@ -254,17 +299,25 @@ impl Run<'_> {
         let world = self.world;
         let a = &mut self.agents[i];
         if !a.moving() {
+            a.normals.clear();
             return;
         }
         if !inside && a.state == AgentState::Walk {
             a.state = AgentState::Return;
             a.new_heading(p.0, leader_x);
+            a.new_run(world);
         } else if inside && a.state == AgentState::Return {
             a.state = AgentState::Walk;
         }
-        if a.run_left <= 0.0 {
+        if !a.normals.is_empty() {
+            // A contact ends the run: turn away and draw a new run length.
             a.new_heading(p.0, leader_x);
-            a.run_left = exponential(&mut a.rng, world.swarm.mean_run_length);
+            a.new_run(world);
+            a.normals.clear();
+            self.stats.collisions += 1;
+        } else if a.run_left <= 0.0 {
+            a.new_heading(p.0, leader_x);
+            a.new_run(world);
         }
         if a.state == AgentState::Walk && a.stop_in <= 0.0 {
             a.state = AgentState::Pause;
@@ -339,19 +392,77 @@ impl Run<'_> {
                         });
                     }
                 }
-                RawEvent::AgentContact { a, b } => {
-                    let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                RawEvent::AgentContact { a, b, started } => {
+                    self.set_near((a, Other::Agent(b)), started);
+                }
+                RawEvent::ObstacleContact {
+                    a,
+                    obstacle,
+                    started,
+                } => {
+                    let other = if obstacle == SIDES {
+                        Other::Sides
+                    } else {
+                        Other::Obstacle(obstacle)
+                    };
+                    self.set_near((a, other), started);
+                }
+            }
+        }
+    }
+
+    fn set_near(&mut self, pair: (u32, Other), started: bool) {
+        if started {
+            self.near.insert(pair);
+        } else {
+            self.near.remove(&pair);
+            self.touching.remove(&pair);
+        }
+    }
+
+    /// Finds the near pairs whose bodies have just come to touch at `pos` and gives each
+    /// moving agent involved the outward normal of the contact, from the exact geometry.
+    fn detect_touches(&mut self, pos: &[P]) {
+        let world = self.world;
+        let r = world.swarm.body_radius;
+        for &(a, other) in &self.near {
+            let pa = pos[a as usize];
+            let mut normals: [Option<(usize, P)>; 4] = [None; 4];
+            let gap = match other {
+                Other::Agent(b) => {
+                    let pb = pos[b as usize];
                     let d = (pa.0 - pb.0, pa.1 - pb.1);
                     let len = d.0.hypot(d.1);
                     if len > 0.0 {
                         let n = (d.0 / len, d.1 / len);
-                        self.agents[a as usize].normals.push(n);
-                        self.agents[b as usize].normals.push((-n.0, -n.1));
+                        normals[0] = Some((a as usize, n));
+                        normals[1] = Some((b as usize, (-n.0, -n.1)));
                     }
+                    len - 2.0 * r
                 }
-                RawEvent::ObstacleContact { a } => {
-                    if let Some(n) = obstacle_normal(self.world, pos[a as usize]) {
-                        self.agents[a as usize].normals.push(n);
+                Other::Obstacle(k) => {
+                    let Some(o) = world.obstacles.get(k as usize) else {
+                        continue;
+                    };
+                    normals[0] = gradient(|q| o.signed_distance(q), pa).map(|n| (a as usize, n));
+                    o.signed_distance(pa) - r
+                }
+                Other::Sides => {
+                    let sides = side_gaps(world, pa, r);
+                    for (slot, (g, n)) in normals.iter_mut().zip(sides) {
+                        if g <= TOUCH_GAP {
+                            *slot = Some((a as usize, n));
+                        }
+                    }
+                    sides.iter().map(|s| s.0).fold(f64::INFINITY, f64::min)
+                }
+            };
+            if gap > TOUCH_GAP {
+                self.touching.remove(&(a, other));
+            } else if self.touching.insert((a, other)) {
+                for (i, n) in normals.into_iter().flatten() {
+                    if self.agents[i].moving() {
+                        self.agents[i].normals.push(n);
                     }
                 }
             }
@@ -384,6 +495,8 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         landmarks: Vec::new(),
         landmarks_started: false,
         open: HashMap::new(),
+        near: BTreeSet::new(),
+        touching: BTreeSet::new(),
         log: EncounterLog::default(),
         stats: SimStats::default(),
         rng,
@@ -415,6 +528,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         let leader_x = world.leader_x(t);
         let last = k == n_steps;
         if !last {
+            run.detect_touches(&pos);
             for (i, &p) in pos.iter().enumerate() {
                 run.update_agent(i, p, t, domain, leader_x);
             }
@@ -458,19 +572,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
             break;
         }
         let step_len = world.swarm.speed * dt;
-        for (i, &p) in pos.iter().enumerate() {
-            let a = &mut run.agents[i];
-            if !a.moving() {
-                a.normals.clear();
-                continue;
-            }
-            if !a.normals.is_empty() {
-                // A contact ends the run: turn away and draw a new run length.
-                a.new_heading(p.0, leader_x);
-                a.run_left = exponential(&mut a.rng, world.swarm.mean_run_length);
-                a.normals.clear();
-                run.stats.collisions += 1;
-            }
+        for a in run.agents.iter_mut().filter(|a| a.moving()) {
             a.run_left -= step_len;
             if a.state == AgentState::Walk {
                 a.stop_in -= dt;

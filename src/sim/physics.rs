@@ -44,8 +44,14 @@ const SIDE_THICKNESS: f32 = 1.0;
 const SKIN_FACTOR: f32 = 0.04;
 /// Broad-phase skin, metres.
 const BROAD_PHASE_SKIN: f32 = 0.01;
-/// Distance under which Rapier creates (speculative) contacts, metres.
-const PREDICTION_DISTANCE: f32 = 2e-4;
+/// Rapier's contacts are speculative: a pair gets a contact constraint once its gap is
+/// below the prediction distance, and the solver then stops the bodies exactly at contact.
+/// The distance must exceed what two agents close in one step (2 v dt), or they overlap
+/// before the solver sees them; this is that multiple of v dt (with a margin for agents
+/// pushed faster than v).
+const PREDICTION_STEPS: f64 = 3.0;
+/// Smallest prediction distance, metres.
+const MIN_PREDICTION_DISTANCE: f64 = 2e-4;
 /// Slop kept by the CCD clamp, metres (CCD is off; kept tiny for consistency).
 const ALLOWED_LINEAR_ERROR: f32 = 5e-5;
 /// A contact pair whose configuration moved less than this since its last full update
@@ -54,15 +60,20 @@ const CONTACT_RECYCLE_DISTANCE: f32 = 5e-4;
 /// Fastest penetration recovery, m/s.
 const MAX_CORRECTIVE_VELOCITY: f32 = 0.1;
 
+/// Obstacle index that stands for the arena's sides.
+pub(crate) const SIDES: u32 = u32::MAX;
+
 /// A raw event, decoded from collider handles to agent indices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum RawEvent {
     /// Sensors of `a < b` started (`true`) or stopped (`false`) intersecting.
     Sensor { a: u32, b: u32, started: bool },
-    /// The solid bodies of agents `a < b` came into contact.
-    AgentContact { a: u32, b: u32 },
-    /// Agent `a` came into contact with an obstacle or an arena side.
-    ObstacleContact { a: u32 },
+    /// The solid bodies of agents `a < b` came within the contact prediction distance
+    /// (`started`) or left it.
+    AgentContact { a: u32, b: u32, started: bool },
+    /// Agent `a` came within the prediction distance of obstacle `obstacle` (an index into
+    /// `World::obstacles`; [`SIDES`] for the arena's sides) or left it.
+    ObstacleContact { a: u32, obstacle: u32, started: bool },
 }
 
 /// Collects events during a step. Rapier's handler takes `&self`, hence the mutex; it is
@@ -99,10 +110,21 @@ impl EventHandler for Collector {
                 b,
                 started: event.started(),
             },
-            _ if !event.started() => return,
-            (KIND_SOLID, KIND_SOLID) if i1 != i2 => RawEvent::AgentContact { a, b },
-            (KIND_SOLID, KIND_OBSTACLE) => RawEvent::ObstacleContact { a: i1 },
-            (KIND_OBSTACLE, KIND_SOLID) => RawEvent::ObstacleContact { a: i2 },
+            (KIND_SOLID, KIND_SOLID) if i1 != i2 => RawEvent::AgentContact {
+                a,
+                b,
+                started: event.started(),
+            },
+            (KIND_SOLID, KIND_OBSTACLE) => RawEvent::ObstacleContact {
+                a: i1,
+                obstacle: i2,
+                started: event.started(),
+            },
+            (KIND_OBSTACLE, KIND_SOLID) => RawEvent::ObstacleContact {
+                a: i2,
+                obstacle: i1,
+                started: event.started(),
+            },
             _ => return,
         };
         if let Ok(mut events) = self.events.lock() {
@@ -181,10 +203,11 @@ fn obstacle_collider(o: &Obstacle) -> Option<ColliderBuilder> {
 impl Scene {
     /// Builds the scene with one agent at each of `positions`.
     pub(crate) fn new(world: &World, positions: &[(f64, f64)], dt: f64) -> Self {
+        let prediction = Self::prediction_distance(world, dt) as f32;
         let params = IntegrationParameters {
             dt: dt as f32,
             length_unit: BROAD_PHASE_SKIN / SKIN_FACTOR,
-            normalized_prediction_distance: PREDICTION_DISTANCE * SKIN_FACTOR / BROAD_PHASE_SKIN,
+            normalized_prediction_distance: prediction * SKIN_FACTOR / BROAD_PHASE_SKIN,
             normalized_allowed_linear_error: ALLOWED_LINEAR_ERROR * SKIN_FACTOR / BROAD_PHASE_SKIN,
             normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR / BROAD_PHASE_SKIN,
             normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR / BROAD_PHASE_SKIN,
@@ -217,17 +240,17 @@ impl Scene {
                     .translation(Vector::new(cx, cy))
                     .collision_groups(obstacle_groups)
                     .friction(0.0)
-                    .user_data(KIND_OBSTACLE),
+                    .user_data(KIND_OBSTACLE | u128::from(SIDES)),
                 fixed,
                 &mut bodies,
             );
         }
-        for o in &world.obstacles {
+        for (k, o) in world.obstacles.iter().enumerate() {
             if let Some(c) = obstacle_collider(o) {
                 colliders.insert_with_parent(
                     c.collision_groups(obstacle_groups)
                         .friction(0.0)
-                        .user_data(KIND_OBSTACLE),
+                        .user_data(KIND_OBSTACLE | k as u128),
                     fixed,
                     &mut bodies,
                 );
@@ -290,6 +313,12 @@ impl Scene {
             collector: Collector::default(),
             agents,
         }
+    }
+
+    /// Gap below which Rapier reports a contact pair (and creates speculative contacts),
+    /// metres.
+    pub(crate) fn prediction_distance(world: &World, dt: f64) -> f64 {
+        (PREDICTION_STEPS * world.swarm.speed * dt).max(MIN_PREDICTION_DISTANCE)
     }
 
     /// Current position of agent `i`, metres.
