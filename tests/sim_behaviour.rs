@@ -91,7 +91,11 @@ fn runs_are_exponential_with_mean_lambda_at_speed_v() {
     );
     // Exponential: the standard deviation equals the mean (within 10 %).
     let var = runs.iter().map(|r| (r - mean_run).powi(2)).sum::<f64>() / runs.len() as f64;
-    assert!((var.sqrt() / mean_run - 1.0).abs() < 0.1, "sd {}", var.sqrt());
+    assert!(
+        (var.sqrt() / mean_run - 1.0).abs() < 0.1,
+        "sd {}",
+        var.sqrt()
+    );
 
     // Pauses: exponential durations of mean 1 s, at rate 0.2 per walking second.
     let end = out.stats.simulated_time;

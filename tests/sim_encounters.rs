@@ -5,6 +5,9 @@ use std::collections::HashMap;
 use swarmmap::sim::{SimOptions, simulate};
 use swarmmap::world::{Obstacle, Placement, World};
 
+/// True contacts of each pair: `(start, end, samples within r_d)`.
+type Contacts = HashMap<(u32, u32), Vec<(f64, f64, usize)>>;
+
 /// A small, crowded arena so that encounters are frequent; no sweep.
 fn crowded(width: f64, agents: usize, duration: f64) -> World {
     let mut w = World::empty("crowded", width, width);
@@ -35,7 +38,7 @@ fn encounters_match_brute_force_centre_distances() {
 
     // Oracle: maximal runs of samples with centres within r_d; an interval ends at the
     // first sample where they are not (or at the final time).
-    let mut truth: HashMap<(u32, u32), Vec<(f64, f64, usize)>> = HashMap::new();
+    let mut truth: Contacts = HashMap::new();
     let mut open: HashMap<(u32, u32), (f64, usize)> = HashMap::new();
     for f in &frames {
         let t = f[0].time;
@@ -60,12 +63,18 @@ fn encounters_match_brute_force_centre_distances() {
     let mut recorded: HashMap<(u32, u32), Vec<(f64, f64)>> = HashMap::new();
     for e in &out.log.encounters {
         assert!(e.a < e.b && e.start <= e.end);
-        recorded.entry((e.a, e.b)).or_default().push((e.start, e.end));
+        recorded
+            .entry((e.a, e.b))
+            .or_default()
+            .push((e.start, e.end));
         let matched = truth.get(&(e.a, e.b)).is_some_and(|v| {
             v.iter()
                 .any(|&(s, t, _)| (s - e.start).abs() <= tol && (t - e.end).abs() <= tol)
         });
-        assert!(matched, "encounter {e:?} has no true contact within one step");
+        assert!(
+            matched,
+            "encounter {e:?} has no true contact within one step"
+        );
     }
     let mut long = 0;
     for (key, v) in &truth {
@@ -81,7 +90,10 @@ fn encounters_match_brute_force_centre_distances() {
             );
         }
     }
-    assert!(long > 100, "only {long} long contacts: the test is too weak");
+    assert!(
+        long > 100,
+        "only {long} long contacts: the test is too weak"
+    );
     // Sorted by (start, a, b).
     assert!(out.log.encounters.windows(2).all(|p| {
         (p[0].start, p[0].a, p[0].b)

@@ -66,7 +66,10 @@ fn same_seed_same_bytes_and_golden_hash() {
     run_to(b.path(), &w, 42);
     let (da, db) = (digest(a.path()), digest(b.path()));
     assert_eq!(da, db, "two runs with the same seed differ");
-    assert_eq!(da, GOLDEN, "golden hash changed (see the comment on GOLDEN)");
+    assert_eq!(
+        da, GOLDEN,
+        "golden hash changed (see the comment on GOLDEN)"
+    );
 }
 
 #[test]
@@ -104,7 +107,11 @@ fn files_have_the_documented_columns_and_order() {
     }
     let st = read("static_intervals.csv");
     assert!(st.starts_with("agent,start,end,reason\n"));
-    let reasons: Vec<&str> = st.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    let reasons: Vec<&str> = st
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
     assert!(reasons.iter().all(|r| *r == "landmark" || *r == "pause"));
     assert!(reasons.contains(&"landmark") && reasons.contains(&"pause"));
     let leader = read("leader.csv");

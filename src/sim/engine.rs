@@ -3,7 +3,7 @@
 
 use super::landmarks;
 use super::params::{
-    AgentState, SimError, SimOptions, SimOutput, SimStats, TrajectorySample, Trajectories,
+    AgentState, SimError, SimOptions, SimOutput, SimStats, Trajectories, TrajectorySample,
 };
 use super::physics::{RawEvent, SIDES, Scene};
 use super::placement;
@@ -202,7 +202,10 @@ fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
     let non_negative: [(&'static str, f64); 3] = [
         ("swarm.speed", s.speed),
         ("swarm.stop_rate", s.stop_rate),
-        ("simulation.dispersion_time", world.simulation.dispersion_time),
+        (
+            "simulation.dispersion_time",
+            world.simulation.dispersion_time,
+        ),
     ];
     for (field, value) in non_negative {
         if !(value.is_finite() && value >= 0.0) {
@@ -381,7 +384,9 @@ impl Run<'_> {
                 RawEvent::Sensor { a, b, started } => {
                     if started {
                         let (pa, pb) = (pos[a as usize], pos[b as usize]);
-                        self.open.entry((a, b)).or_insert((t, [pa.0, pa.1, pb.0, pb.1]));
+                        self.open
+                            .entry((a, b))
+                            .or_insert((t, [pa.0, pa.1, pb.0, pb.1]));
                     } else if let Some((start, truth)) = self.open.remove(&(a, b)) {
                         self.log.encounters.push(Encounter {
                             start,
@@ -491,7 +496,9 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     let mut scene = Scene::new(world, &start, dt);
     let mut run = Run {
         world,
-        agents: (0..n_agents).map(|i| Agent::new(opts.seed, i, world)).collect(),
+        agents: (0..n_agents)
+            .map(|i| Agent::new(opts.seed, i, world))
+            .collect(),
         landmarks: Vec::new(),
         landmarks_started: false,
         open: HashMap::new(),
@@ -557,9 +564,10 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         if !last {
             for i in 0..n_agents {
                 let a = &run.agents[i];
-                let vel = a
-                    .moving()
-                    .then(|| (a.heading.0 * world.swarm.speed, a.heading.1 * world.swarm.speed));
+                let vel = a.moving().then_some((
+                    a.heading.0 * world.swarm.speed,
+                    a.heading.1 * world.swarm.speed,
+                ));
                 scene.set_motion(i, vel);
             }
         }

@@ -217,7 +217,7 @@ mod tests {
             .collect();
         let radius = 0.7;
         let d = hops(&positions, radius);
-        let chosen = select(&positions, &vec![false; 60], radius, 8, &mut rng);
+        let chosen = select(&positions, &[false; 60], radius, 8, &mut rng);
         assert_eq!(chosen.len(), 8);
         for k in 1..chosen.len() {
             let comp_of = |i: usize| (0..60).filter(|&j| d[i][j] != UNREACHED).min();

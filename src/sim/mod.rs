@@ -46,5 +46,5 @@ pub use output::{
     write_run,
 };
 pub use params::{
-    AgentState, SimError, SimOptions, SimOutput, SimStats, TrajectorySample, Trajectories,
+    AgentState, SimError, SimOptions, SimOutput, SimStats, Trajectories, TrajectorySample,
 };

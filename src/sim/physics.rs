@@ -73,7 +73,11 @@ pub(crate) enum RawEvent {
     AgentContact { a: u32, b: u32, started: bool },
     /// Agent `a` came within the prediction distance of obstacle `obstacle` (an index into
     /// `World::obstacles`; [`SIDES`] for the arena's sides) or left it.
-    ObstacleContact { a: u32, obstacle: u32, started: bool },
+    ObstacleContact {
+        a: u32,
+        obstacle: u32,
+        started: bool,
+    },
 }
 
 /// Collects events during a step. Rapier's handler takes `&self`, hence the mutex; it is
@@ -142,8 +146,7 @@ impl EventHandler for Collector {
     ) {
     }
 
-    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {
-    }
+    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
 }
 
 /// The Rapier state of a run.
@@ -169,10 +172,11 @@ fn v(x: f64, y: f64) -> Vector {
 
 fn obstacle_collider(o: &Obstacle) -> Option<ColliderBuilder> {
     Some(match o {
-        Obstacle::Rect { min, max } => {
-            ColliderBuilder::cuboid(((max.0 - min.0) / 2.0) as f32, ((max.1 - min.1) / 2.0) as f32)
-                .translation(v((min.0 + max.0) / 2.0, (min.1 + max.1) / 2.0))
-        }
+        Obstacle::Rect { min, max } => ColliderBuilder::cuboid(
+            ((max.0 - min.0) / 2.0) as f32,
+            ((max.1 - min.1) / 2.0) as f32,
+        )
+        .translation(v((min.0 + max.0) / 2.0, (min.1 + max.1) / 2.0)),
         Obstacle::Circle { center, radius } => {
             ColliderBuilder::ball(*radius as f32).translation(v(center.0, center.1))
         }
@@ -209,8 +213,10 @@ impl Scene {
             length_unit: BROAD_PHASE_SKIN / SKIN_FACTOR,
             normalized_prediction_distance: prediction * SKIN_FACTOR / BROAD_PHASE_SKIN,
             normalized_allowed_linear_error: ALLOWED_LINEAR_ERROR * SKIN_FACTOR / BROAD_PHASE_SKIN,
-            normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR / BROAD_PHASE_SKIN,
-            normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR / BROAD_PHASE_SKIN,
+            normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR
+                / BROAD_PHASE_SKIN,
+            normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR
+                / BROAD_PHASE_SKIN,
             normalized_max_linear_velocity: 1e4,
             // Agents are set to their walking velocity every step and only need to not
             // overlap: one iteration suffices, and CCD is useless at 2 mm per step.
@@ -220,11 +226,8 @@ impl Scene {
         };
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
-        let obstacle_groups = InteractionGroups::new(
-            GROUP_OBSTACLE,
-            GROUP_SOLID,
-            InteractionTestMode::And,
-        );
+        let obstacle_groups =
+            InteractionGroups::new(GROUP_OBSTACLE, GROUP_SOLID, InteractionTestMode::And);
         let fixed = bodies.insert(RigidBodyBuilder::fixed());
         let (w, h) = (world.arena.width as f32, world.arena.height as f32);
         let t = SIDE_THICKNESS;
