@@ -1,0 +1,647 @@
+//! The simulation loop: agent behaviour, landmark upkeep, the leader, and the bookkeeping
+//! that turns physics events into the encounter log.
+
+use super::landmarks;
+use super::params::{
+    AgentState, SimError, SimOptions, SimOutput, SimStats, Trajectories, TrajectorySample,
+};
+use super::physics::{RawEvent, SIDES, Scene};
+use super::placement;
+use crate::log::{AgentId, Encounter, EncounterLog, StaticInterval, StaticReason};
+use crate::world::World;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::{BTreeSet, HashMap};
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Half-width of the cone of headings an agent outside D(t) draws from, radians: the
+/// leader's signal-strength gradient points along x, and the noise keeps returning agents
+/// from queueing behind an obstacle in single file.
+pub const RETURN_NOISE: f64 = PI / 3.0;
+
+/// Mean run length while returning, metres: a returning agent re-senses the leader's
+/// gradient this often, so that a turn away from an obstacle is a short detour rather
+/// than a full random-walk run away from the leader.
+pub const RETURN_RUN_LENGTH: f64 = 0.3;
+
+/// Interval of the leader's track in `leader.csv`, seconds (rounded to whole steps).
+pub const LEADER_INTERVAL: f64 = 1.0;
+
+/// Draws for a heading that points away from every contact before falling back to the
+/// mean of the contact normals.
+const HEADING_TRIES: usize = 64;
+
+/// Gap under which a body counts as touching what Rapier reported near it, metres: the
+/// speculative contacts stop bodies at a gap of zero, up to f32 rounding.
+const TOUCH_GAP: f64 = 1e-4;
+
+type P = (f64, f64);
+
+/// What an agent's body can touch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Other {
+    /// Another agent, with a larger index.
+    Agent(u32),
+    /// `World::obstacles[k]`.
+    Obstacle(u32),
+    /// The arena's sides.
+    Sides,
+}
+
+struct Agent {
+    state: AgentState,
+    /// Unit heading.
+    heading: P,
+    /// Metres left in the current run.
+    run_left: f64,
+    /// Walking seconds until the next spontaneous stop.
+    stop_in: f64,
+    /// Start of the current static interval (pause or landmark), seconds.
+    static_since: f64,
+    /// End of the current pause, seconds.
+    pause_until: f64,
+    /// Outward normals of the contacts that started at the last step.
+    normals: Vec<P>,
+    rng: ChaCha8Rng,
+}
+
+fn exponential(rng: &mut ChaCha8Rng, mean: f64) -> f64 {
+    // 1 - u is in (0, 1], so the logarithm is finite.
+    -mean * (1.0 - rng.random::<f64>()).ln()
+}
+
+fn unit(angle: f64) -> P {
+    (angle.cos(), angle.sin())
+}
+
+impl Agent {
+    fn new(seed: u64, index: usize, world: &World) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        // Stream 0 is the run's own (placement, landmarks); agents get their own streams so
+        // that one agent's draws never shift another's.
+        rng.set_stream(index as u64 + 1);
+        let heading = unit(2.0 * PI * rng.random::<f64>());
+        let run_left = exponential(&mut rng, world.swarm.mean_run_length);
+        let stop_in = Self::draw_stop(&mut rng, world);
+        Self {
+            state: AgentState::Walk,
+            heading,
+            run_left,
+            stop_in,
+            static_since: 0.0,
+            pause_until: 0.0,
+            normals: Vec::new(),
+            rng,
+        }
+    }
+
+    fn draw_stop(rng: &mut ChaCha8Rng, world: &World) -> f64 {
+        if world.swarm.stop_rate > 0.0 {
+            exponential(rng, 1.0 / world.swarm.stop_rate)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// A fresh heading for the agent's mode: isotropic while walking, towards `leader_x`
+    /// within ±[`RETURN_NOISE`] while returning; away from every contact in `normals`.
+    fn new_heading(&mut self, x: f64, leader_x: f64) {
+        let returning = self.state == AgentState::Return;
+        let base = if leader_x >= x { 0.0 } else { PI };
+        let draw = |rng: &mut ChaCha8Rng| {
+            if returning {
+                unit(base + RETURN_NOISE * (2.0 * rng.random::<f64>() - 1.0))
+            } else {
+                unit(2.0 * PI * rng.random::<f64>())
+            }
+        };
+        let away = |h: P, normals: &[P]| normals.iter().all(|n| h.0 * n.0 + h.1 * n.1 >= 0.0);
+        for _ in 0..HEADING_TRIES {
+            let h = draw(&mut self.rng);
+            if away(h, &self.normals) {
+                self.heading = h;
+                return;
+            }
+            // Mirroring across the contact plane keeps the draw uniform on the free side
+            // when there is one contact.
+            if let [n] = self.normals[..] {
+                let d = h.0 * n.0 + h.1 * n.1;
+                self.heading = (h.0 - 2.0 * d * n.0, h.1 - 2.0 * d * n.1);
+                return;
+            }
+        }
+        let s = self
+            .normals
+            .iter()
+            .fold((0.0, 0.0), |s, n| (s.0 + n.0, s.1 + n.1));
+        let len = s.0.hypot(s.1);
+        if len > 0.0 {
+            self.heading = (s.0 / len, s.1 / len);
+        }
+    }
+
+    /// Draws the length of a new run for the agent's mode, metres.
+    fn new_run(&mut self, world: &World) {
+        let mean = if self.state == AgentState::Return {
+            RETURN_RUN_LENGTH.min(world.swarm.mean_run_length)
+        } else {
+            world.swarm.mean_run_length
+        };
+        self.run_left = exponential(&mut self.rng, mean);
+    }
+
+    fn moving(&self) -> bool {
+        matches!(self.state, AgentState::Walk | AgentState::Return)
+    }
+}
+
+/// Outward unit normal of a signed distance `f` at `p`, by central differences.
+fn gradient(f: impl Fn(P) -> f64, p: P) -> Option<P> {
+    let h = 1e-6;
+    let gx = f((p.0 + h, p.1)) - f((p.0 - h, p.1));
+    let gy = f((p.0, p.1 + h)) - f((p.0, p.1 - h));
+    let len = gx.hypot(gy);
+    (len > 0.0 && len.is_finite()).then(|| (gx / len, gy / len))
+}
+
+/// Gaps between a body of radius `r` at `p` and the arena's four sides, with the
+/// inward normals of the sides.
+fn side_gaps(world: &World, p: P, r: f64) -> [(f64, P); 4] {
+    let (w, h) = (world.arena.width, world.arena.height);
+    [
+        (p.0 - r, (1.0, 0.0)),
+        (w - p.0 - r, (-1.0, 0.0)),
+        (p.1 - r, (0.0, 1.0)),
+        (h - p.1 - r, (0.0, -1.0)),
+    ]
+}
+
+fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
+    let s = &world.swarm;
+    let positive: [(&'static str, f64); 9] = [
+        ("simulation.dt", world.simulation.dt),
+        ("swarm.detection_radius", s.detection_radius),
+        ("swarm.body_radius", s.body_radius),
+        ("swarm.mean_run_length", s.mean_run_length),
+        ("swarm.mean_stop_duration", s.mean_stop_duration),
+        ("swarm.comm_radius", s.comm_radius),
+        ("leader.speed", world.leader.speed),
+        ("arena.width", world.arena.width),
+        ("arena.height", world.arena.height),
+    ];
+    for (field, value) in positive {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(SimError::InvalidWorld {
+                field,
+                value,
+                expected: "expected a finite number greater than 0",
+            });
+        }
+    }
+    let non_negative: [(&'static str, f64); 3] = [
+        ("swarm.speed", s.speed),
+        ("swarm.stop_rate", s.stop_rate),
+        (
+            "simulation.dispersion_time",
+            world.simulation.dispersion_time,
+        ),
+    ];
+    for (field, value) in non_negative {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(SimError::InvalidWorld {
+                field,
+                value,
+                expected: "expected a finite number, 0 or more",
+            });
+        }
+    }
+    if !(0.0..=1.0).contains(&s.landmark_fraction) {
+        return Err(SimError::InvalidWorld {
+            field: "swarm.landmark_fraction",
+            value: s.landmark_fraction,
+            expected: "expected a fraction between 0 and 1",
+        });
+    }
+    if !world.total_duration().is_finite() {
+        return Err(SimError::InvalidWorld {
+            field: "leader.end_x",
+            value: world.leader.end_x,
+            expected: "the sweep must have a finite duration",
+        });
+    }
+    if let Some(i) = opts.trajectories
+        && !(i.is_finite() && i > 0.0)
+    {
+        return Err(SimError::InvalidOption {
+            option: "trajectories",
+            value: i,
+            expected: "expected an interval in seconds greater than 0",
+        });
+    }
+    Ok(())
+}
+
+/// Number of whole steps of `dt` closest to `interval`, at least one.
+fn steps_per(interval: f64, dt: f64) -> u64 {
+    ((interval / dt).round() as u64).max(1)
+}
+
+/// Mutable state of a run besides the physics.
+struct Run<'w> {
+    world: &'w World,
+    agents: Vec<Agent>,
+    /// Landmarks in the order they were chosen.
+    landmarks: Vec<usize>,
+    landmarks_started: bool,
+    open: HashMap<(u32, u32), (f64, [f64; 4])>,
+    /// Pairs Rapier reports within the contact prediction distance.
+    near: BTreeSet<(u32, Other)>,
+    /// Near pairs whose bodies touch (gap below [`TOUCH_GAP`]).
+    touching: BTreeSet<(u32, Other)>,
+    log: EncounterLog,
+    stats: SimStats,
+    rng: ChaCha8Rng,
+}
+
+impl Run<'_> {
+    fn close_static(&mut self, i: usize, t: f64, reason: StaticReason) {
+        self.log.static_intervals.push(StaticInterval {
+            agent: i as AgentId,
+            start: self.agents[i].static_since,
+            end: t,
+            reason,
+        });
+    }
+
+    /// Starts a new run for an agent that resumes walking.
+    fn resume(&mut self, i: usize, p: P, leader_x: f64) {
+        let a = &mut self.agents[i];
+        a.state = AgentState::Walk;
+        a.normals.clear();
+        a.new_heading(p.0, leader_x);
+        a.new_run(self.world);
+    }
+
+    /// Mode changes at time `t` for agent `i` at `p`, before the step.
+    fn update_agent(&mut self, i: usize, p: P, t: f64, domain: P, leader_x: f64) {
+        let inside = p.0 >= domain.0 && p.0 <= domain.1;
+        match self.agents[i].state {
+            AgentState::Pause if t >= self.agents[i].pause_until => {
+                self.close_static(i, t, StaticReason::Pause);
+                self.agents[i].state = AgentState::Walk;
+            }
+            AgentState::Landmark if !inside => {
+                self.close_static(i, t, StaticReason::Landmark);
+                self.landmarks.retain(|&l| l != i);
+                self.stats.landmark_releases_outside += 1;
+                self.resume(i, p, leader_x);
+            }
+            _ => {}
+        }
+        let world = self.world;
+        let a = &mut self.agents[i];
+        if !a.moving() {
+            a.normals.clear();
+            return;
+        }
+        if !inside && a.state == AgentState::Walk {
+            a.state = AgentState::Return;
+            a.new_heading(p.0, leader_x);
+            a.new_run(world);
+        } else if inside && a.state == AgentState::Return {
+            a.state = AgentState::Walk;
+        }
+        if !a.normals.is_empty() {
+            // A contact ends the run: turn away and draw a new run length.
+            a.new_heading(p.0, leader_x);
+            a.new_run(world);
+            a.normals.clear();
+            self.stats.collisions += 1;
+        } else if a.run_left <= 0.0 {
+            a.new_heading(p.0, leader_x);
+            a.new_run(world);
+        }
+        if a.state == AgentState::Walk && a.stop_in <= 0.0 {
+            a.state = AgentState::Pause;
+            a.static_since = t;
+            a.pause_until = t + exponential(&mut a.rng, world.swarm.mean_stop_duration);
+            a.stop_in = Agent::draw_stop(&mut a.rng, world);
+            self.stats.pauses += 1;
+        }
+    }
+
+    /// Holds round(fraction × agents inside D(t)) landmarks among the agents inside D(t).
+    fn upkeep_landmarks(&mut self, pos: &[P], t: f64, domain: P, leader_x: f64) {
+        let inside: Vec<usize> = (0..pos.len())
+            .filter(|&i| pos[i].0 >= domain.0 && pos[i].0 <= domain.1)
+            .collect();
+        let target = (self.world.swarm.landmark_fraction * inside.len() as f64).round() as usize;
+        while self.landmarks.len() > target {
+            // Release the newest: the older landmarks keep their MaxMin spread.
+            let Some(i) = self.landmarks.pop() else { break };
+            self.close_static(i, t, StaticReason::Landmark);
+            self.stats.landmark_releases_surplus += 1;
+            self.resume(i, pos[i], leader_x);
+        }
+        if self.landmarks.len() < target {
+            let cand: Vec<P> = inside.iter().map(|&i| pos[i]).collect();
+            let flags: Vec<bool> = inside
+                .iter()
+                .map(|&i| self.agents[i].state == AgentState::Landmark)
+                .collect();
+            let need = target - self.landmarks.len();
+            let picks = landmarks::select(
+                &cand,
+                &flags,
+                self.world.swarm.comm_radius,
+                need,
+                &mut self.rng,
+            );
+            for k in picks {
+                let i = inside[k];
+                if self.agents[i].state == AgentState::Pause {
+                    self.close_static(i, t, StaticReason::Pause);
+                }
+                let a = &mut self.agents[i];
+                a.state = AgentState::Landmark;
+                a.static_since = t;
+                self.landmarks.push(i);
+                if self.landmarks_started {
+                    self.stats.landmark_replacements += 1;
+                } else {
+                    self.stats.landmark_selections += 1;
+                }
+            }
+        }
+        self.landmarks_started = true;
+    }
+
+    /// Applies the events seen at time `t` (configuration `pos`).
+    fn handle_events(&mut self, events: &[RawEvent], pos: &[P], t: f64) {
+        for &ev in events {
+            match ev {
+                RawEvent::Sensor { a, b, started } => {
+                    if started {
+                        let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                        self.open
+                            .entry((a, b))
+                            .or_insert((t, [pa.0, pa.1, pb.0, pb.1]));
+                    } else if let Some((start, truth)) = self.open.remove(&(a, b)) {
+                        self.log.encounters.push(Encounter {
+                            start,
+                            end: t,
+                            a,
+                            b,
+                            truth: Some(truth),
+                        });
+                    }
+                }
+                RawEvent::AgentContact { a, b, started } => {
+                    self.set_near((a, Other::Agent(b)), started);
+                }
+                RawEvent::ObstacleContact {
+                    a,
+                    obstacle,
+                    started,
+                } => {
+                    let other = if obstacle == SIDES {
+                        Other::Sides
+                    } else {
+                        Other::Obstacle(obstacle)
+                    };
+                    self.set_near((a, other), started);
+                }
+            }
+        }
+    }
+
+    fn set_near(&mut self, pair: (u32, Other), started: bool) {
+        if started {
+            self.near.insert(pair);
+        } else {
+            self.near.remove(&pair);
+            self.touching.remove(&pair);
+        }
+    }
+
+    /// Finds the near pairs whose bodies have just come to touch at `pos` and gives each
+    /// moving agent involved the outward normal of the contact, from the exact geometry.
+    fn detect_touches(&mut self, pos: &[P]) {
+        let world = self.world;
+        let r = world.swarm.body_radius;
+        for &(a, other) in &self.near {
+            let pa = pos[a as usize];
+            let mut normals: [Option<(usize, P)>; 4] = [None; 4];
+            let gap = match other {
+                Other::Agent(b) => {
+                    let pb = pos[b as usize];
+                    let d = (pa.0 - pb.0, pa.1 - pb.1);
+                    let len = d.0.hypot(d.1);
+                    if len > 0.0 {
+                        let n = (d.0 / len, d.1 / len);
+                        normals[0] = Some((a as usize, n));
+                        normals[1] = Some((b as usize, (-n.0, -n.1)));
+                    }
+                    len - 2.0 * r
+                }
+                Other::Obstacle(k) => {
+                    let Some(o) = world.obstacles.get(k as usize) else {
+                        continue;
+                    };
+                    normals[0] = gradient(|q| o.signed_distance(q), pa).map(|n| (a as usize, n));
+                    o.signed_distance(pa) - r
+                }
+                Other::Sides => {
+                    let sides = side_gaps(world, pa, r);
+                    for (slot, (g, n)) in normals.iter_mut().zip(sides) {
+                        if g <= TOUCH_GAP {
+                            *slot = Some((a as usize, n));
+                        }
+                    }
+                    sides.iter().map(|s| s.0).fold(f64::INFINITY, f64::min)
+                }
+            };
+            if gap > TOUCH_GAP {
+                self.touching.remove(&(a, other));
+            } else if self.touching.insert((a, other)) {
+                for (i, n) in normals.into_iter().flatten() {
+                    if self.agents[i].moving() {
+                        self.agents[i].normals.push(n);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Runs the swarm through the whole sweep of `world` (dispersion, then the leader from
+/// `start_x` to `end_x`) and returns the encounter log.
+///
+/// Deterministic: the same world and options give the same output, wall times aside.
+pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError> {
+    let wall = Instant::now();
+    check(world, opts)?;
+    let dt = world.simulation.dt;
+    let n_agents = world.swarm.agents;
+    let total = world.total_duration();
+    // Whole steps covering the run; the tolerance absorbs rounding in total / dt.
+    let n_steps = ((total / dt) * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+    let end_time = n_steps as f64 * dt;
+    let dispersion = world.simulation.dispersion_time;
+    let eps = dt * 1e-6;
+
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let start = placement::place(world, &mut rng)?;
+    let mut scene = Scene::new(world, &start, dt);
+    let mut run = Run {
+        world,
+        agents: (0..n_agents)
+            .map(|i| Agent::new(opts.seed, i, world))
+            .collect(),
+        landmarks: Vec::new(),
+        landmarks_started: false,
+        open: HashMap::new(),
+        near: BTreeSet::new(),
+        touching: BTreeSet::new(),
+        log: EncounterLog::default(),
+        stats: SimStats::default(),
+        rng,
+    };
+    let traj_every = opts.trajectories.map(|i| steps_per(i, dt));
+    let mut traj = traj_every.map(|k| Trajectories {
+        interval: k as f64 * dt,
+        samples: Vec::new(),
+    });
+    let leader_every = steps_per(LEADER_INTERVAL, dt);
+    let progress_every = (n_steps / 200).max(1);
+
+    let mut pos: Vec<P> = start;
+    let mut events = Vec::new();
+    let mut physics_time = 0.0;
+    let mut landmark_time = 0.0;
+    for k in 0..=n_steps {
+        let t = k as f64 * dt;
+        for (i, p) in pos.iter_mut().enumerate() {
+            *p = scene.position(i);
+            if !(p.0.is_finite() && p.1.is_finite()) {
+                return Err(SimError::NonFinite {
+                    agent: i as AgentId,
+                    time: t,
+                });
+            }
+        }
+        let domain = world.domain(t);
+        let leader_x = world.leader_x(t);
+        let last = k == n_steps;
+        if !last {
+            run.detect_touches(&pos);
+            for (i, &p) in pos.iter().enumerate() {
+                run.update_agent(i, p, t, domain, leader_x);
+            }
+            if t >= dispersion - eps {
+                let t0 = Instant::now();
+                run.upkeep_landmarks(&pos, t, domain, leader_x);
+                landmark_time += t0.elapsed().as_secs_f64();
+            }
+        }
+        if let (Some(every), Some(traj)) = (traj_every, traj.as_mut())
+            && k % every == 0
+        {
+            for (i, &p) in pos.iter().enumerate() {
+                traj.samples.push(TrajectorySample {
+                    time: t,
+                    agent: i as AgentId,
+                    x: p.0,
+                    y: p.1,
+                    state: run.agents[i].state,
+                });
+            }
+        }
+        if k % leader_every == 0 || last {
+            run.log.leader.push((t, leader_x));
+        }
+        if !last {
+            for i in 0..n_agents {
+                let a = &run.agents[i];
+                let vel = a.moving().then_some((
+                    a.heading.0 * world.swarm.speed,
+                    a.heading.1 * world.swarm.speed,
+                ));
+                scene.set_motion(i, vel);
+            }
+        }
+        let t0 = Instant::now();
+        events.clear();
+        scene.step(if last { 0.0 } else { dt }, &mut events);
+        physics_time += t0.elapsed().as_secs_f64();
+        run.handle_events(&events, &pos, t);
+        if last {
+            break;
+        }
+        let step_len = world.swarm.speed * dt;
+        for a in run.agents.iter_mut().filter(|a| a.moving()) {
+            a.run_left -= step_len;
+            if a.state == AgentState::Walk {
+                a.stop_in -= dt;
+            }
+        }
+        if let Some(report) = opts.progress
+            && k % progress_every == 0
+        {
+            report(k as f64 / n_steps.max(1) as f64);
+        }
+    }
+
+    // Close what is still open at the final time.
+    let mut still_open: Vec<_> = run.open.drain().collect();
+    still_open.sort_unstable_by_key(|&((a, b), _)| (a, b));
+    for ((a, b), (start, truth)) in still_open {
+        run.log.encounters.push(Encounter {
+            start,
+            end: end_time,
+            a,
+            b,
+            truth: Some(truth),
+        });
+    }
+    for i in 0..n_agents {
+        match run.agents[i].state {
+            AgentState::Pause => run.close_static(i, end_time, StaticReason::Pause),
+            AgentState::Landmark => run.close_static(i, end_time, StaticReason::Landmark),
+            _ => {}
+        }
+    }
+    let mut log = run.log;
+    log.encounters.sort_by(|x, y| {
+        x.start
+            .total_cmp(&y.start)
+            .then(x.a.cmp(&y.a))
+            .then(x.b.cmp(&y.b))
+    });
+    log.static_intervals.sort_by(|x, y| {
+        x.agent
+            .cmp(&y.agent)
+            .then(x.start.total_cmp(&y.start))
+            .then(x.end.total_cmp(&y.end))
+    });
+    if let Some(report) = opts.progress {
+        report(1.0);
+    }
+    let mut stats = run.stats;
+    stats.steps = n_steps;
+    stats.simulated_time = end_time;
+    stats.encounters = log.encounters.len();
+    stats.static_intervals = log.static_intervals.len();
+    stats.physics_time_s = physics_time;
+    stats.landmark_time_s = landmark_time;
+    stats.wall_time_s = wall.elapsed().as_secs_f64();
+    Ok(SimOutput {
+        seed: opts.seed,
+        dt,
+        leader_interval: leader_every as f64 * dt,
+        log,
+        trajectories: traj,
+        stats,
+    })
+}

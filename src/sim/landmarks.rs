@@ -1,0 +1,270 @@
+//! Landmark selection by MaxMin on the hop distance of the communication graph (paper
+//! §"Exploration and Event Collection", after de Silva and Tenenbaum's MaxMin landmarks,
+//! "Sparse multidimensional scaling using landmark points", 2004).
+//!
+//! The communication graph joins the agents inside D(t) whose centres are within the
+//! communication radius. Each new landmark is drawn as follows: pick a connected component
+//! with probability equal to its share of the agents (so a connected graph always picks
+//! itself); if the component holds no landmark yet, pick one of its agents uniformly,
+//! otherwise pick the agent whose hop distance to the nearest landmark is largest (ties
+//! broken uniformly at random). Hop distances to the landmark set are kept by a
+//! multi-source BFS, updated after each pick by a BFS from the new landmark that stops
+//! where distances do not improve.
+//!
+//! Complexity: building the graph with a uniform grid of cell size the communication
+//! radius costs O(n + E); each pick costs O(n) plus the pruned BFS, at most O(n + E).
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use std::collections::{HashMap, VecDeque};
+
+/// Hop distance of an agent no landmark can reach.
+const UNREACHED: u32 = u32::MAX;
+
+/// The communication graph over a set of candidate agents.
+struct Graph {
+    adjacency: Vec<Vec<u32>>,
+    component: Vec<u32>,
+    component_sizes: Vec<usize>,
+}
+
+fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
+    let n = positions.len();
+    let key = |p: (f64, f64)| ((p.0 / radius).floor() as i64, (p.1 / radius).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+    for (i, &p) in positions.iter().enumerate() {
+        grid.entry(key(p)).or_default().push(i as u32);
+    }
+    let r2 = radius * radius;
+    let mut adjacency = vec![Vec::new(); n];
+    for (i, &p) in positions.iter().enumerate() {
+        let (kx, ky) = key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(ids) = grid.get(&(kx + dx, ky + dy)) {
+                    for &j in ids {
+                        let q = positions[j as usize];
+                        let d2 = (p.0 - q.0).powi(2) + (p.1 - q.1).powi(2);
+                        if j as usize != i && d2 <= r2 {
+                            adjacency[i].push(j);
+                        }
+                    }
+                }
+            }
+        }
+        // Grid order depends on the cell layout only; sorting makes BFS order canonical.
+        adjacency[i].sort_unstable();
+    }
+    let mut component = vec![u32::MAX; n];
+    let mut component_sizes = Vec::new();
+    let mut queue = VecDeque::new();
+    for s in 0..n {
+        if component[s] != u32::MAX {
+            continue;
+        }
+        let c = component_sizes.len() as u32;
+        component[s] = c;
+        queue.push_back(s as u32);
+        let mut size = 0;
+        while let Some(u) = queue.pop_front() {
+            size += 1;
+            for &w in &adjacency[u as usize] {
+                if component[w as usize] == u32::MAX {
+                    component[w as usize] = c;
+                    queue.push_back(w);
+                }
+            }
+        }
+        component_sizes.push(size);
+    }
+    Graph {
+        adjacency,
+        component,
+        component_sizes,
+    }
+}
+
+/// Lowers `dist` by a BFS from `source`, visiting only vertices whose distance improves.
+fn relax_from(graph: &Graph, dist: &mut [u32], source: usize) {
+    let mut queue = VecDeque::new();
+    dist[source] = 0;
+    queue.push_back(source as u32);
+    while let Some(u) = queue.pop_front() {
+        let du = dist[u as usize];
+        for &w in &graph.adjacency[u as usize] {
+            if dist[w as usize] > du + 1 {
+                dist[w as usize] = du + 1;
+                queue.push_back(w);
+            }
+        }
+    }
+}
+
+/// Chooses `count` new landmarks among `positions` (the agents inside D(t)), of which those
+/// flagged in `is_landmark` already are landmarks. Returns indices into `positions`, in the
+/// order chosen; fewer than `count` only if every candidate becomes a landmark.
+pub(crate) fn select(
+    positions: &[(f64, f64)],
+    is_landmark: &[bool],
+    radius: f64,
+    count: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<usize> {
+    let n = positions.len();
+    if count == 0 || n == 0 {
+        return Vec::new();
+    }
+    let graph = build_graph(positions, radius);
+    let mut landmark = is_landmark.to_vec();
+    let mut dist = vec![UNREACHED; n];
+    let mut has_landmark = vec![false; graph.component_sizes.len()];
+    for i in (0..n).filter(|&i| landmark[i]) {
+        has_landmark[graph.component[i] as usize] = true;
+        relax_from(&graph, &mut dist, i);
+    }
+    // Non-landmark agents left per component, to skip exhausted components.
+    let mut free = vec![0usize; graph.component_sizes.len()];
+    for i in (0..n).filter(|&i| !landmark[i]) {
+        free[graph.component[i] as usize] += 1;
+    }
+    let mut chosen = Vec::with_capacity(count);
+    while chosen.len() < count {
+        let weight: usize = (0..free.len())
+            .filter(|&c| free[c] > 0)
+            .map(|c| graph.component_sizes[c])
+            .sum();
+        if weight == 0 {
+            break;
+        }
+        let mut ticket = rng.random_range(0..weight);
+        let mut comp = 0;
+        for c in (0..free.len()).filter(|&c| free[c] > 0) {
+            if ticket < graph.component_sizes[c] {
+                comp = c;
+                break;
+            }
+            ticket -= graph.component_sizes[c];
+        }
+        let members = (0..n).filter(|&i| graph.component[i] as usize == comp && !landmark[i]);
+        let pick = if has_landmark[comp] {
+            // MaxMin: farthest (in hops) from the landmarks; reservoir-sample among ties.
+            let mut best = None;
+            let mut best_d = 0;
+            let mut ties = 0u32;
+            for i in members {
+                let d = dist[i];
+                if best.is_none() || d > best_d {
+                    best = Some(i);
+                    best_d = d;
+                    ties = 1;
+                } else if d == best_d {
+                    ties += 1;
+                    if rng.random_range(0..ties) == 0 {
+                        best = Some(i);
+                    }
+                }
+            }
+            best
+        } else {
+            let members: Vec<usize> = members.collect();
+            (!members.is_empty()).then(|| members[rng.random_range(0..members.len())])
+        };
+        let Some(pick) = pick else { break };
+        landmark[pick] = true;
+        has_landmark[comp] = true;
+        free[comp] -= 1;
+        relax_from(&graph, &mut dist, pick);
+        chosen.push(pick);
+    }
+    chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    /// Brute-force hop distances by Floyd–Warshall on a small graph.
+    fn hops(positions: &[(f64, f64)], radius: f64) -> Vec<Vec<u32>> {
+        let n = positions.len();
+        let mut d = vec![vec![UNREACHED; n]; n];
+        for i in 0..n {
+            d[i][i] = 0;
+            for j in 0..n {
+                let (p, q) = (positions[i], positions[j]);
+                if i != j && (p.0 - q.0).hypot(p.1 - q.1) <= radius {
+                    d[i][j] = 1;
+                }
+            }
+        }
+        for k in 0..n {
+            for i in 0..n {
+                for j in 0..n {
+                    if d[i][k] != UNREACHED && d[k][j] != UNREACHED {
+                        d[i][j] = d[i][j].min(d[i][k] + d[k][j]);
+                    }
+                }
+            }
+        }
+        d
+    }
+
+    #[test]
+    fn maxmin_picks_are_farthest_from_previous_landmarks() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let positions: Vec<(f64, f64)> = (0..60)
+            .map(|_| (rng.random::<f64>() * 6.0, rng.random::<f64>() * 2.0))
+            .collect();
+        let radius = 0.7;
+        let d = hops(&positions, radius);
+        let chosen = select(&positions, &[false; 60], radius, 8, &mut rng);
+        assert_eq!(chosen.len(), 8);
+        for k in 1..chosen.len() {
+            let comp_of = |i: usize| (0..60).filter(|&j| d[i][j] != UNREACHED).min();
+            let c = comp_of(chosen[k]);
+            let prev: Vec<usize> = chosen[..k]
+                .iter()
+                .copied()
+                .filter(|&l| comp_of(l) == c)
+                .collect();
+            if prev.is_empty() {
+                continue;
+            }
+            let to_prev = |i: usize| prev.iter().map(|&l| d[i][l]).min().unwrap_or(UNREACHED);
+            let best = (0..60)
+                .filter(|&i| comp_of(i) == c && !chosen[..k].contains(&i))
+                .map(to_prev)
+                .max();
+            assert_eq!(Some(to_prev(chosen[k])), best, "pick {k} is not MaxMin");
+        }
+    }
+
+    #[test]
+    fn components_get_landmarks_in_proportion_to_their_size() {
+        // Two far-apart clusters of 30 and 10 agents: over many draws of one landmark,
+        // the big cluster is picked about 75 % of the time.
+        let mut positions = Vec::new();
+        for i in 0..30 {
+            positions.push((0.01 * i as f64, 0.0));
+        }
+        for i in 0..10 {
+            positions.push((10.0 + 0.01 * i as f64, 0.0));
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let trials = 4000;
+        let big = (0..trials)
+            .filter(|_| select(&positions, &[false; 40], 0.1, 1, &mut rng)[0] < 30)
+            .count();
+        let share = big as f64 / trials as f64;
+        assert!((share - 0.75).abs() < 0.03, "share {share}");
+    }
+
+    #[test]
+    fn every_candidate_can_become_a_landmark() {
+        let positions = [(0.0, 0.0), (5.0, 0.0), (5.5, 0.0)];
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let mut chosen = select(&positions, &[false, true, false], 1.0, 5, &mut rng);
+        chosen.sort_unstable();
+        assert_eq!(chosen, vec![0, 2]);
+    }
+}

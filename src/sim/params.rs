@@ -1,0 +1,173 @@
+//! What a simulation run takes besides the world, and what it returns.
+
+use crate::log::{AgentId, EncounterLog};
+use std::path::PathBuf;
+
+/// Options of one run that are not part of the world.
+#[derive(Clone, Copy)]
+pub struct SimOptions<'a> {
+    /// Seed of every random choice of the run (the CLI defaults it to the world's `seed`).
+    pub seed: u64,
+    /// Record agent positions every this many seconds of simulated time (rounded to a whole
+    /// number of time steps, at least one); `None` records none (default: `None`).
+    pub trajectories: Option<f64>,
+    /// Called now and then with the fraction of the run done, in `[0, 1]`.
+    pub progress: Option<&'a dyn Fn(f64)>,
+}
+
+impl<'a> SimOptions<'a> {
+    /// Options with the given seed, no trajectories and no progress reports.
+    #[must_use]
+    pub fn new(seed: u64) -> Self {
+        Self {
+            seed,
+            trajectories: None,
+            progress: None,
+        }
+    }
+
+    /// Records trajectories every `interval` seconds of simulated time.
+    #[must_use]
+    pub fn with_trajectories(mut self, interval: f64) -> Self {
+        self.trajectories = Some(interval);
+        self
+    }
+
+    /// Reports progress through `f`.
+    #[must_use]
+    pub fn with_progress(mut self, f: &'a dyn Fn(f64)) -> Self {
+        self.progress = Some(f);
+        self
+    }
+}
+
+/// What an agent is doing, as it would report it to the leader.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AgentState {
+    /// Random walk inside D(t).
+    Walk,
+    /// A spontaneous stop of the random walk.
+    Pause,
+    /// Held static as a landmark.
+    Landmark,
+    /// Outside D(t), steering back towards the leader.
+    Return,
+}
+
+impl AgentState {
+    /// The name used in `trajectories.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AgentState::Walk => "walk",
+            AgentState::Pause => "pause",
+            AgentState::Landmark => "landmark",
+            AgentState::Return => "return",
+        }
+    }
+}
+
+/// One recorded position of one agent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrajectorySample {
+    /// Simulated time in seconds.
+    pub time: f64,
+    pub agent: AgentId,
+    /// True position in metres.
+    pub x: f64,
+    pub y: f64,
+    pub state: AgentState,
+}
+
+/// Decimated trajectories of every agent, sorted by `(time, agent)`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Trajectories {
+    /// Sampling interval actually used, seconds (a whole number of time steps).
+    pub interval: f64,
+    pub samples: Vec<TrajectorySample>,
+}
+
+/// Counters and timings of a run. Everything but the wall times is deterministic.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SimStats {
+    /// Physics steps taken.
+    pub steps: u64,
+    /// Simulated time in seconds (a whole number of steps, `>= world.total_duration()`).
+    pub simulated_time: f64,
+    /// Encounters recorded.
+    pub encounters: usize,
+    /// Static intervals recorded (landmark and pause).
+    pub static_intervals: usize,
+    /// Spontaneous stops started.
+    pub pauses: usize,
+    /// Landmarks chosen by the first selection after dispersion.
+    pub landmark_selections: usize,
+    /// Landmarks chosen later to keep the fraction (replacements of released ones).
+    pub landmark_replacements: usize,
+    /// Landmarks released because they fell out of D(t).
+    pub landmark_releases_outside: usize,
+    /// Landmarks released because fewer agents were inside D(t).
+    pub landmark_releases_surplus: usize,
+    /// Contacts (agent–agent or agent–obstacle) that triggered a new heading.
+    pub collisions: usize,
+    /// Wall time of the whole run, seconds (not deterministic).
+    pub wall_time_s: f64,
+    /// Wall time inside the Rapier step, seconds (not deterministic).
+    pub physics_time_s: f64,
+    /// Wall time of landmark selection, seconds (not deterministic).
+    pub landmark_time_s: f64,
+}
+
+/// The result of [`simulate`](super::simulate).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOutput {
+    /// Seed the run used.
+    pub seed: u64,
+    /// Time step the run used, seconds.
+    pub dt: f64,
+    /// Interval of `leader.csv` samples, seconds.
+    pub leader_interval: f64,
+    pub log: EncounterLog,
+    pub trajectories: Option<Trajectories>,
+    pub stats: SimStats,
+}
+
+/// Why a run could not be done or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A world parameter the simulator depends on is out of range (a validated world never
+    /// has one; hand-built worlds may).
+    #[error("world parameter `{field}` is {value}: {expected}")]
+    InvalidWorld {
+        field: &'static str,
+        value: f64,
+        expected: &'static str,
+    },
+    /// A run option is out of range.
+    #[error("option `{option}` is {value}: {expected}")]
+    InvalidOption {
+        option: &'static str,
+        value: f64,
+        expected: &'static str,
+    },
+    /// The agents could not be placed without overlapping obstacles or each other.
+    #[error(
+        "could not place agent {placed} of {agents} in the free part of the start region \
+         after {attempts} tries; enlarge `swarm.placement` or move obstacles away from the \
+         leader's start"
+    )]
+    Placement {
+        placed: usize,
+        agents: usize,
+        attempts: usize,
+    },
+    /// The physics produced a non-finite position (a bug, reported rather than propagated).
+    #[error("agent {agent} reached a non-finite position at t = {time} s")]
+    NonFinite { agent: AgentId, time: f64 },
+    /// An output file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}

@@ -1,0 +1,382 @@
+//! The Rapier 2D scene: fixed colliders for the arena's sides and the obstacles, one rigid
+//! body per agent with a solid ball and a sensor ball, and an event handler that turns
+//! Rapier's collision events into encounters and contacts.
+//!
+//! Encounters come from sensor intersection: each agent carries a sensor ball of radius
+//! r_d / 2, so two sensors intersect exactly when the centres are within r_d. Sensors only
+//! see sensors (collision group 2) and solids only see solids and obstacles (groups 1
+//! and 3), so a sensor never reports an obstacle or another agent's body.
+//!
+//! Timing: Rapier's narrow phase runs at the start of `PhysicsPipeline::step`, on the
+//! positions the bodies have before the step integrates them. Every event handled during
+//! the step that advances `t_k → t_{k+1}` therefore describes the configuration at `t_k`
+//! (the centres crossed r_d during the previous step), and is stamped `t_k`. A final step
+//! with `dt = 0` reports the configuration at the last time.
+//!
+//! Static agents (paused or landmarks) stay dynamic bodies with their translations locked:
+//! a locked body has infinite effective mass, so moving agents bounce off it and never push
+//! it, and its sensor still reports encounters.
+
+use crate::world::{Obstacle, World};
+use rapier2d::prelude::*;
+use std::sync::Mutex;
+
+/// Collider kinds, stored in the high bits of a collider's `user_data`.
+const KIND_SOLID: u128 = 1 << 64;
+const KIND_SENSOR: u128 = 2 << 64;
+const KIND_OBSTACLE: u128 = 3 << 64;
+const KIND_MASK: u128 = 0xff << 64;
+
+const GROUP_SOLID: Group = Group::GROUP_1;
+const GROUP_SENSOR: Group = Group::GROUP_2;
+const GROUP_OBSTACLE: Group = Group::GROUP_3;
+
+/// Thickness of the fixed slabs that bound the arena outside its sides, metres.
+const SIDE_THICKNESS: f32 = 1.0;
+
+/// Rapier scales its tolerances by `length_unit`, tuned for metre-sized bodies; ours are
+/// millimetres, so every tolerance is set explicitly in metres below. The one tolerance
+/// that cannot be set on its own is the broad phase's fat-AABB skin, `0.04 × length_unit`:
+/// a leaf of the BVH is only updated once its collider has moved by more than the skin.
+/// Agents move 2 mm per step, so the default 0.4 mm skin (at a 1 cm unit) would update every
+/// leaf at every step; a 1 cm skin updates a leaf every five steps. Larger skins cost more
+/// than they save in dense swarms (more candidate pairs); see `docs/simulation.md`.
+const SKIN_FACTOR: f32 = 0.04;
+/// Broad-phase skin, metres.
+const BROAD_PHASE_SKIN: f32 = 0.01;
+/// Rapier's contacts are speculative: a pair gets a contact constraint once its gap is
+/// below the prediction distance, and the solver then stops the bodies exactly at contact.
+/// The distance must exceed what two agents close in one step (2 v dt), or they overlap
+/// before the solver sees them; this is that multiple of v dt (with a margin for agents
+/// pushed faster than v).
+const PREDICTION_STEPS: f64 = 3.0;
+/// Smallest prediction distance, metres.
+const MIN_PREDICTION_DISTANCE: f64 = 2e-4;
+/// Slop kept by the CCD clamp, metres (CCD is off; kept tiny for consistency).
+const ALLOWED_LINEAR_ERROR: f32 = 5e-5;
+/// A contact pair whose configuration moved less than this since its last full update
+/// keeps its contact points, metres.
+const CONTACT_RECYCLE_DISTANCE: f32 = 5e-4;
+/// Fastest penetration recovery, m/s.
+const MAX_CORRECTIVE_VELOCITY: f32 = 0.1;
+
+/// Obstacle index that stands for the arena's sides.
+pub(crate) const SIDES: u32 = u32::MAX;
+
+/// A raw event, decoded from collider handles to agent indices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum RawEvent {
+    /// Sensors of `a < b` started (`true`) or stopped (`false`) intersecting.
+    Sensor { a: u32, b: u32, started: bool },
+    /// The solid bodies of agents `a < b` came within the contact prediction distance
+    /// (`started`) or left it.
+    AgentContact { a: u32, b: u32, started: bool },
+    /// Agent `a` came within the prediction distance of obstacle `obstacle` (an index into
+    /// `World::obstacles`; [`SIDES`] for the arena's sides) or left it.
+    ObstacleContact {
+        a: u32,
+        obstacle: u32,
+        started: bool,
+    },
+}
+
+/// Collects events during a step. Rapier's handler takes `&self`, hence the mutex; it is
+/// never contended (the pipeline runs single-threaded without the `parallel` feature).
+#[derive(Default)]
+struct Collector {
+    events: Mutex<Vec<RawEvent>>,
+}
+
+fn decode(data: u128) -> (u128, u32) {
+    (data & KIND_MASK, (data & 0xffff_ffff) as u32)
+}
+
+impl EventHandler for Collector {
+    fn handle_collision_event(
+        &self,
+        _bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+        event: CollisionEvent,
+        _contact_pair: Option<&ContactPair>,
+    ) {
+        let (Some(c1), Some(c2)) = (
+            colliders.get(event.collider1()),
+            colliders.get(event.collider2()),
+        ) else {
+            return;
+        };
+        let (k1, i1) = decode(c1.user_data);
+        let (k2, i2) = decode(c2.user_data);
+        let (a, b) = (i1.min(i2), i1.max(i2));
+        let ev = match (k1, k2) {
+            (KIND_SENSOR, KIND_SENSOR) if i1 != i2 => RawEvent::Sensor {
+                a,
+                b,
+                started: event.started(),
+            },
+            (KIND_SOLID, KIND_SOLID) if i1 != i2 => RawEvent::AgentContact {
+                a,
+                b,
+                started: event.started(),
+            },
+            (KIND_SOLID, KIND_OBSTACLE) => RawEvent::ObstacleContact {
+                a: i1,
+                obstacle: i2,
+                started: event.started(),
+            },
+            (KIND_OBSTACLE, KIND_SOLID) => RawEvent::ObstacleContact {
+                a: i2,
+                obstacle: i1,
+                started: event.started(),
+            },
+            _ => return,
+        };
+        if let Ok(mut events) = self.events.lock() {
+            events.push(ev);
+        }
+    }
+
+    fn handle_contact_force_event(
+        &self,
+        _dt: Real,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        _contact_pair: &ContactPair,
+        _total_force_magnitude: Real,
+    ) {
+    }
+
+    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
+}
+
+/// The Rapier state of a run.
+pub(crate) struct Scene {
+    params: IntegrationParameters,
+    pipeline: PhysicsPipeline,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    collector: Collector,
+    agents: Vec<RigidBodyHandle>,
+}
+
+fn v(x: f64, y: f64) -> Vector {
+    Vector::new(x as f32, y as f32)
+}
+
+fn obstacle_collider(o: &Obstacle) -> Option<ColliderBuilder> {
+    Some(match o {
+        Obstacle::Rect { min, max } => ColliderBuilder::cuboid(
+            ((max.0 - min.0) / 2.0) as f32,
+            ((max.1 - min.1) / 2.0) as f32,
+        )
+        .translation(v((min.0 + max.0) / 2.0, (min.1 + max.1) / 2.0)),
+        Obstacle::Circle { center, radius } => {
+            ColliderBuilder::ball(*radius as f32).translation(v(center.0, center.1))
+        }
+        // A closed polyline is the polygon's exact boundary; agents start outside it and
+        // move far less than their radius per step, so they never reach the inside.
+        Obstacle::Polygon { points } => {
+            let n = points.len() as u32;
+            if n < 3 {
+                return None;
+            }
+            let vertices = points.iter().map(|p| v(p.0, p.1)).collect();
+            let indices = (0..n).map(|i| [i, (i + 1) % n]).collect();
+            ColliderBuilder::polyline(vertices, Some(indices))
+        }
+        // A thick segment is exactly a capsule.
+        Obstacle::Wall {
+            from,
+            to,
+            thickness,
+        } => ColliderBuilder::capsule_from_endpoints(
+            v(from.0, from.1),
+            v(to.0, to.1),
+            (*thickness / 2.0) as f32,
+        ),
+    })
+}
+
+impl Scene {
+    /// Builds the scene with one agent at each of `positions`.
+    pub(crate) fn new(world: &World, positions: &[(f64, f64)], dt: f64) -> Self {
+        let prediction = Self::prediction_distance(world, dt) as f32;
+        let params = IntegrationParameters {
+            dt: dt as f32,
+            length_unit: BROAD_PHASE_SKIN / SKIN_FACTOR,
+            normalized_prediction_distance: prediction * SKIN_FACTOR / BROAD_PHASE_SKIN,
+            normalized_allowed_linear_error: ALLOWED_LINEAR_ERROR * SKIN_FACTOR / BROAD_PHASE_SKIN,
+            normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR
+                / BROAD_PHASE_SKIN,
+            normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR
+                / BROAD_PHASE_SKIN,
+            normalized_max_linear_velocity: 1e4,
+            // Agents are set to their walking velocity every step and only need to not
+            // overlap: one iteration suffices, and CCD is useless at 2 mm per step.
+            num_solver_iterations: 1,
+            max_ccd_substeps: 0,
+            ..IntegrationParameters::default()
+        };
+        let mut bodies = RigidBodySet::new();
+        let mut colliders = ColliderSet::new();
+        let obstacle_groups =
+            InteractionGroups::new(GROUP_OBSTACLE, GROUP_SOLID, InteractionTestMode::And);
+        let fixed = bodies.insert(RigidBodyBuilder::fixed());
+        let (w, h) = (world.arena.width as f32, world.arena.height as f32);
+        let t = SIDE_THICKNESS;
+        let sides = [
+            (w / 2.0, -t / 2.0, w / 2.0 + t, t / 2.0),
+            (w / 2.0, h + t / 2.0, w / 2.0 + t, t / 2.0),
+            (-t / 2.0, h / 2.0, t / 2.0, h / 2.0 + t),
+            (w + t / 2.0, h / 2.0, t / 2.0, h / 2.0 + t),
+        ];
+        for (cx, cy, hx, hy) in sides {
+            colliders.insert_with_parent(
+                ColliderBuilder::cuboid(hx, hy)
+                    .translation(Vector::new(cx, cy))
+                    .collision_groups(obstacle_groups)
+                    .friction(0.0)
+                    .user_data(KIND_OBSTACLE | u128::from(SIDES)),
+                fixed,
+                &mut bodies,
+            );
+        }
+        for (k, o) in world.obstacles.iter().enumerate() {
+            if let Some(c) = obstacle_collider(o) {
+                colliders.insert_with_parent(
+                    c.collision_groups(obstacle_groups)
+                        .friction(0.0)
+                        .user_data(KIND_OBSTACLE | k as u128),
+                    fixed,
+                    &mut bodies,
+                );
+            }
+        }
+        let solid_groups = InteractionGroups::new(
+            GROUP_SOLID,
+            GROUP_SOLID | GROUP_OBSTACLE,
+            InteractionTestMode::And,
+        );
+        let sensor_groups =
+            InteractionGroups::new(GROUP_SENSOR, GROUP_SENSOR, InteractionTestMode::And);
+        let body_radius = world.swarm.body_radius as f32;
+        let sensor_radius = (world.swarm.detection_radius / 2.0) as f32;
+        let mut agents = Vec::with_capacity(positions.len());
+        for (i, p) in positions.iter().enumerate() {
+            let handle = bodies.insert(
+                RigidBodyBuilder::dynamic()
+                    .translation(v(p.0, p.1))
+                    .lock_rotations()
+                    .gravity_scale(0.0)
+                    .can_sleep(false)
+                    .user_data(i as u128),
+            );
+            colliders.insert_with_parent(
+                ColliderBuilder::ball(body_radius)
+                    .density(1.0)
+                    .friction(0.0)
+                    .restitution(0.0)
+                    .collision_groups(solid_groups)
+                    .active_events(ActiveEvents::COLLISION_EVENTS)
+                    .user_data(KIND_SOLID | i as u128),
+                handle,
+                &mut bodies,
+            );
+            colliders.insert_with_parent(
+                ColliderBuilder::ball(sensor_radius)
+                    .sensor(true)
+                    .density(0.0)
+                    .collision_groups(sensor_groups)
+                    .active_events(ActiveEvents::COLLISION_EVENTS)
+                    .user_data(KIND_SENSOR | i as u128),
+                handle,
+                &mut bodies,
+            );
+            agents.push(handle);
+        }
+        Self {
+            params,
+            pipeline: PhysicsPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: BroadPhaseBvh::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies,
+            colliders,
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::new(),
+            ccd: CCDSolver::new(),
+            collector: Collector::default(),
+            agents,
+        }
+    }
+
+    /// Gap below which Rapier reports a contact pair (and creates speculative contacts),
+    /// metres.
+    pub(crate) fn prediction_distance(world: &World, dt: f64) -> f64 {
+        (PREDICTION_STEPS * world.swarm.speed * dt).max(MIN_PREDICTION_DISTANCE)
+    }
+
+    /// Current position of agent `i`, metres.
+    pub(crate) fn position(&self, i: usize) -> (f64, f64) {
+        let t = self.bodies[self.agents[i]].translation();
+        (f64::from(t.x), f64::from(t.y))
+    }
+
+    /// Sets agent `i` moving with velocity `vel` (m/s), or static (translations locked)
+    /// when `vel` is `None`.
+    pub(crate) fn set_motion(&mut self, i: usize, vel: Option<(f64, f64)>) {
+        let body = &mut self.bodies[self.agents[i]];
+        match vel {
+            Some((vx, vy)) => {
+                if body.is_translation_locked() {
+                    body.lock_translations(false, true);
+                }
+                // Setting a body's velocity flags it as modified by the user, which costs a
+                // pass of Rapier's change tracking: skip it when nothing changes.
+                let target = v(vx, vy);
+                if body.linvel() != target {
+                    body.set_linvel(target, true);
+                }
+            }
+            None => {
+                if !body.is_translation_locked() {
+                    body.lock_translations(true, true);
+                    body.set_linvel(Vector::ZERO, true);
+                }
+            }
+        }
+    }
+
+    /// Advances by `dt` seconds (`0` only runs collision detection) and appends the events
+    /// seen at the configuration before the step to `out`, in a deterministic order.
+    pub(crate) fn step(&mut self, dt: f64, out: &mut Vec<RawEvent>) {
+        self.params.dt = dt as f32;
+        self.pipeline.step(
+            Vector::ZERO,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &self.collector,
+        );
+        if let Ok(mut events) = self.collector.events.lock() {
+            events.sort_unstable();
+            out.append(&mut events);
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! The motion model and the exploration rules, checked on recorded trajectories against
+//! the parameters and the exact geometry (not against the simulator's own counters).
+
+use swarmmap::log::StaticReason;
+use swarmmap::sim::{AgentState, SimOptions, SimOutput, simulate};
+use swarmmap::world::{Obstacle, Placement, World};
+
+/// A world without a sweep: the leader stays at `start_x` and the run lasts `duration` s.
+fn still_world(width: f64, height: f64, agents: usize, duration: f64) -> World {
+    let mut w = World::empty("still", width, height);
+    w.swarm.agents = agents;
+    w.leader.window = width;
+    w.leader.start_x = width / 2.0;
+    w.leader.end_x = width / 2.0;
+    w.simulation.dispersion_time = duration;
+    w
+}
+
+fn run(world: &World, seed: u64, every: f64) -> SimOutput {
+    simulate(world, &SimOptions::new(seed).with_trajectories(every)).expect("simulation runs")
+}
+
+/// Positions per agent, in time order, with states.
+fn tracks(out: &SimOutput, agents: usize) -> Vec<Vec<(f64, f64, f64, AgentState)>> {
+    let mut t = vec![Vec::new(); agents];
+    for s in &out.trajectories.as_ref().expect("trajectories").samples {
+        t[s.agent as usize].push((s.time, s.x, s.y, s.state));
+    }
+    t
+}
+
+#[test]
+fn runs_are_exponential_with_mean_lambda_at_speed_v() {
+    // Large empty arena, the whole of it inside D(t): no leader pull, few wall hits.
+    let lambda = 0.3;
+    let mut w = still_world(60.0, 60.0, 100, 300.0);
+    w.swarm.mean_run_length = lambda;
+    w.swarm.landmark_fraction = 0.0;
+    w.swarm.stop_rate = 0.2;
+    w.swarm.mean_stop_duration = 1.0;
+    w.swarm.placement = Placement::Window;
+    let dt = w.simulation.dt;
+    let out = run(&w, 7, dt);
+    let v = w.swarm.speed;
+
+    let mut runs = Vec::new();
+    let (mut dist, mut steps) = (0.0, 0usize);
+    for track in tracks(&out, 100) {
+        // Split each track into straight runs: a turn is a change of direction between two
+        // consecutive moving steps (zero-length steps are pauses, which keep the heading).
+        let mut current = 0.0;
+        let mut last_dir: Option<(f64, f64)> = None;
+        for win in track.windows(2) {
+            let (a, b) = (win[0], win[1]);
+            let d = (b.1 - a.1, b.2 - a.2);
+            let len = d.0.hypot(d.1);
+            if len < 1e-9 {
+                continue;
+            }
+            dist += len;
+            steps += 1;
+            let dir = (d.0 / len, d.1 / len);
+            if let Some(p) = last_dir {
+                let cross = p.0 * dir.1 - p.1 * dir.0;
+                let dot = p.0 * dir.0 + p.1 * dir.1;
+                if cross.atan2(dot).abs() > 0.01 {
+                    // Runs cut short by an arena side are not samples of the run length.
+                    let near_side = a.1.min(60.0 - a.1).min(a.2).min(60.0 - a.2) < 0.02;
+                    if !near_side {
+                        runs.push(current);
+                    }
+                    current = 0.0;
+                }
+            }
+            current += len;
+            last_dir = Some(dir);
+        }
+        // The last run of a track is truncated by the end of the simulation: dropped.
+    }
+    let mean_run = runs.iter().sum::<f64>() / runs.len() as f64;
+    let mean_speed = dist / (steps as f64 * dt);
+    assert!(runs.len() > 5000, "only {} runs", runs.len());
+    assert!(
+        (mean_run / lambda - 1.0).abs() < 0.05,
+        "mean run {mean_run} m vs λ = {lambda} m over {} runs",
+        runs.len()
+    );
+    assert!(
+        (mean_speed / v - 1.0).abs() < 0.05,
+        "mean speed {mean_speed} m/s vs {v}"
+    );
+    // Exponential: the standard deviation equals the mean (within 10 %).
+    let var = runs.iter().map(|r| (r - mean_run).powi(2)).sum::<f64>() / runs.len() as f64;
+    assert!(
+        (var.sqrt() / mean_run - 1.0).abs() < 0.1,
+        "sd {}",
+        var.sqrt()
+    );
+
+    // Pauses: exponential durations of mean 1 s, at rate 0.2 per walking second.
+    let end = out.stats.simulated_time;
+    let pauses: Vec<_> = out
+        .log
+        .static_intervals
+        .iter()
+        .filter(|s| s.reason == StaticReason::Pause)
+        .collect();
+    let complete: Vec<f64> = pauses
+        .iter()
+        .filter(|s| s.end < end)
+        .map(|s| s.end - s.start)
+        .collect();
+    let mean_pause = complete.iter().sum::<f64>() / complete.len() as f64;
+    assert!(
+        (mean_pause / 1.0 - 1.0).abs() < 0.05,
+        "mean pause {mean_pause} s over {} pauses",
+        complete.len()
+    );
+    let paused: f64 = pauses.iter().map(|s| s.end - s.start).sum();
+    let walking = 100.0 * end - paused;
+    let rate = pauses.len() as f64 / walking;
+    assert!((rate / 0.2 - 1.0).abs() < 0.05, "stop rate {rate} /s");
+    // Paused agents do not move.
+    let t = tracks(&out, 100);
+    for s in &pauses {
+        let tr = &t[s.agent as usize];
+        let inside: Vec<_> = tr
+            .iter()
+            .filter(|p| p.0 >= s.start && p.0 < s.end)
+            .collect();
+        assert!(inside.iter().all(|p| p.3 == AgentState::Pause));
+        assert!(
+            inside
+                .windows(2)
+                .all(|w| w[0].1 == w[1].1 && w[0].2 == w[1].2)
+        );
+    }
+}
+
+/// A small world with every kind of obstacle, one touching a side, and a real sweep.
+fn obstacle_world() -> World {
+    let mut w = World::empty("obstacles", 12.0, 4.0);
+    w.obstacles = vec![
+        Obstacle::Rect {
+            min: (4.0, 1.5),
+            max: (8.0, 2.5),
+        },
+        Obstacle::Circle {
+            center: (2.5, 3.0),
+            radius: 0.4,
+        },
+        // Non-convex (an arrow head).
+        Obstacle::Polygon {
+            points: vec![(9.0, 0.5), (10.5, 1.0), (9.0, 1.5), (9.5, 1.0)],
+        },
+        Obstacle::Wall {
+            from: (10.0, 4.0),
+            to: (10.0, 2.5),
+            thickness: 0.1,
+        },
+    ];
+    w.swarm.agents = 100;
+    w.leader.speed = 0.05;
+    w.simulation.dispersion_time = 60.0;
+    w
+}
+
+#[test]
+fn agents_never_enter_obstacles_nor_leave_the_arena() {
+    let w = obstacle_world();
+    let out = run(&w, 3, w.simulation.dt);
+    let r = w.swarm.body_radius;
+    let mut worst = f64::INFINITY;
+    for s in &out.trajectories.as_ref().expect("trajectories").samples {
+        worst = worst.min(w.clearance((s.x, s.y)) - r);
+    }
+    // The body may sink into an obstacle by at most 0.2 mm (solver tolerance); it never
+    // gets its centre inside.
+    assert!(worst > -2e-4, "a body overlaps an obstacle by {} m", -worst);
+    assert!(out.stats.collisions > 0);
+}
+
+#[test]
+fn landmark_fraction_holds_inside_the_leaders_domain() {
+    // The paper's speeds (leader 0.005 m/s, agents 0.1 m/s) on a 6 m arena: a 600 s sweep.
+    let mut w = obstacle_world();
+    w.arena.width = 6.0;
+    w.obstacles.truncate(2);
+    w.leader.speed = 0.005;
+    w.leader.end_x = 4.5;
+    let every = 0.5;
+    let out = run(&w, 11, every);
+    let traj = out.trajectories.as_ref().expect("trajectories");
+    let disp = w.simulation.dispersion_time;
+    let mut checked = 0;
+    let (mut towards, mut return_time) = (0.0, 0.0);
+    let mut prev: Option<&[swarmmap::sim::TrajectorySample]> = None;
+    for chunk in traj.samples.chunks(w.swarm.agents) {
+        // Returning agents close in on the leader's x faster than the leader moves.
+        if let Some(p) = prev {
+            for (a, b) in p.iter().zip(chunk) {
+                if a.state == AgentState::Return && b.state == AgentState::Return {
+                    let dir = (w.leader_x(a.time) - a.x).signum();
+                    towards += (b.x - a.x) * dir;
+                    return_time += b.time - a.time;
+                }
+            }
+        }
+        prev = Some(chunk);
+        let t = chunk[0].time;
+        if t < disp - 1e-9 || t >= out.stats.simulated_time - 1e-9 {
+            continue;
+        }
+        let (x0, x1) = w.domain(t);
+        let inside: Vec<_> = chunk.iter().filter(|s| s.x >= x0 && s.x <= x1).collect();
+        let landmarks = chunk
+            .iter()
+            .filter(|s| s.state == AgentState::Landmark)
+            .count();
+        let landmarks_inside = inside
+            .iter()
+            .filter(|s| s.state == AgentState::Landmark)
+            .count();
+        let target = (w.swarm.landmark_fraction * inside.len() as f64).round() as usize;
+        assert_eq!(landmarks, landmarks_inside, "landmark outside D({t})");
+        assert_eq!(landmarks, target, "at t = {t}: {} inside", inside.len());
+        // Agents outside D(t) are returning (or paused).
+        for s in chunk.iter().filter(|s| s.x < x0 || s.x > x1) {
+            assert!(matches!(s.state, AgentState::Return | AgentState::Pause));
+        }
+        checked += 1;
+    }
+    assert!(checked > 100);
+    let closing = towards / return_time;
+    assert!(
+        closing > w.leader.speed,
+        "returning agents close in at {closing} m/s, the leader moves at {}",
+        w.leader.speed
+    );
+    // The landmarks moved with the leader: some were released and replaced.
+    assert!(out.stats.landmark_selections == 10);
+    assert!(out.stats.landmark_replacements > 0);
+    assert!(out.stats.landmark_releases_outside > 0);
+    // Landmarks do not move during their static intervals.
+    for iv in out
+        .log
+        .static_intervals
+        .iter()
+        .filter(|s| s.reason == StaticReason::Landmark)
+    {
+        let pts: Vec<_> = traj
+            .samples
+            .iter()
+            .filter(|s| s.agent == iv.agent && s.time >= iv.start && s.time < iv.end)
+            .collect();
+        assert!(pts.windows(2).all(|p| p[0].x == p[1].x && p[0].y == p[1].y));
+    }
+}
