@@ -17,6 +17,7 @@ pub mod eval;
 pub mod io;
 pub mod log;
 pub mod mapping;
+pub mod pipeline;
 pub mod sim;
 pub mod topology;
 pub mod world;

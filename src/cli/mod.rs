@@ -2,7 +2,10 @@
 //! code comes from the failure's kind, never from a panic.
 
 mod check;
+mod map;
 mod persistence;
+mod run;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -27,6 +30,32 @@ pub fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
     Failure::Input(e.into())
 }
 
+/// Loads a world file and applies `--set PATH=VALUE` overrides; any problem is an input
+/// error (status 2).
+pub fn load_world(
+    path: &std::path::Path,
+    sets: &[String],
+) -> Result<swarmmap::world::World, Failure> {
+    let mut spec = swarmmap::world::WorldSpec::load(path).map_err(input)?;
+    for assignment in sets {
+        swarmmap::world::apply_assignment(&mut spec, assignment).map_err(input)?;
+    }
+    spec.check().map_err(input)
+}
+
+/// A progress bar on stderr when it is a terminal and `quiet` is off.
+pub fn progress_bar(quiet: bool, label: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        let template = format!("{{spinner}} {label} [{{bar:40}}] {{percent}}% (eta {{eta}})");
+        if let Ok(style) = indicatif::ProgressStyle::with_template(&template) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar
+    })
+}
+
 #[derive(Parser)]
 #[command(
     name = "swarmmap",
@@ -42,6 +71,12 @@ struct Cli {
 enum Command {
     /// Validate a world file and print a short summary.
     Check(check::CheckArgs),
+    /// Simulate the swarm through a world's sweep and write its encounter log.
+    Simulate(simulate::SimulateArgs),
+    /// Map an encounter log: local maps, connections, global map (and truth if known).
+    Map(map::MapArgs),
+    /// Simulate, map, stitch and evaluate a world in one go.
+    Run(run::RunArgs),
     /// Vietoris–Rips persistence diagram (H0, H1) of a CSV of points or distances.
     Persistence(persistence::PersistenceArgs),
 }
@@ -50,6 +85,9 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: Result<(), Failure> = match cli.command {
         Command::Check(args) => check::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
+        Command::Map(args) => map::run(&args),
+        Command::Run(args) => run::run(&args),
         Command::Persistence(a) => persistence::run(a),
     };
     match result {

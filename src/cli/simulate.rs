@@ -1,14 +1,11 @@
 //! `swarmmap simulate WORLD --out DIR [--seed N] [--trajectories [INTERVAL]] [--quiet]`:
 //! runs the swarm through the whole sweep and writes the encounter log.
 
-use super::{Failure, input};
+use super::{Failure, input, load_world, progress_bar};
 use anyhow::Context;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use swarmmap::sim::{SimError, SimOptions, simulate, write_run};
-use swarmmap::world::World;
 
 /// Options of `swarmmap simulate`.
 #[derive(Args, Debug)]
@@ -25,23 +22,18 @@ pub struct SimulateArgs {
     /// simulated time (default interval: 1 s).
     #[arg(long, value_name = "INTERVAL", num_args = 0..=1, default_missing_value = "1.0")]
     pub trajectories: Option<f64>,
+    /// Override a world field, e.g. `--set swarm.detection_radius=0.03` (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
 }
 
 pub fn run(args: &SimulateArgs) -> Result<(), Failure> {
-    let world = World::load(&args.world).map_err(input)?;
+    let world = load_world(&args.world, &args.set)?;
     let seed = args.seed.unwrap_or(world.seed);
-    let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = ProgressBar::new(1000);
-        if let Ok(style) =
-            ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% (eta {eta})")
-        {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        bar
-    });
+    let bar = progress_bar(args.quiet, "simulating");
     let report = |f: f64| {
         if let Some(b) = &bar {
             b.set_position((f * 1000.0) as u64);

@@ -1,0 +1,89 @@
+//! `swarmmap map RUN_DIR [--windows N] [--overlap S]`: local maps, connections and the
+//! global map of an encounter log, from a simulation or a real experiment.
+
+use super::{Failure, input, load_world};
+use clap::Args;
+use std::path::PathBuf;
+use swarmmap::log::EncounterLog;
+use swarmmap::mapping::local::LocalParams;
+use swarmmap::mapping::pipeline::MapConfig;
+use swarmmap::mapping::stitch::StitchParams;
+use swarmmap::pipeline::{Timings, map_log, world_from_run, write_maps};
+use swarmmap::world::MappingParams;
+
+/// Options of `swarmmap map`.
+#[derive(Args, Debug)]
+pub struct MapArgs {
+    /// Directory with encounters.csv (and optionally static_intervals.csv, leader.csv,
+    /// meta.json). Outputs go to RUN_DIR/maps/ and RUN_DIR/summary.json.
+    pub run_dir: PathBuf,
+    /// Number of windows N (default: the world's `mapping.windows`, else 4).
+    #[arg(long)]
+    pub windows: Option<usize>,
+    /// Overlap Δt between windows in seconds (default: the world's `mapping.overlap`,
+    /// else 300).
+    #[arg(long)]
+    pub overlap: Option<f64>,
+    /// World file to evaluate against, instead of the one in RUN_DIR/meta.json. Without
+    /// either, the log is mapped without ground truth.
+    #[arg(long)]
+    pub world: Option<PathBuf>,
+}
+
+pub fn run(args: &MapArgs) -> Result<(), Failure> {
+    let log = EncounterLog::read_dir(&args.run_dir).map_err(input)?;
+    let world = match &args.world {
+        Some(path) => Some(load_world(path, &[])?),
+        None => world_from_run(&args.run_dir).map_err(input)?,
+    };
+    let (mut cfg, stitch) = match &world {
+        Some(w) => (
+            MapConfig::for_world(w),
+            StitchParams {
+                cutoff: w.mapping.cluster_cutoff,
+                neighbours: w.mapping.neighbours,
+            },
+        ),
+        None => {
+            let m = MappingParams::default();
+            let span = log.span().ok_or_else(|| {
+                input(anyhow::anyhow!(
+                    "{}: the log has no encounters to map",
+                    args.run_dir.display()
+                ))
+            })?;
+            (
+                MapConfig {
+                    windows: m.windows,
+                    overlap: m.overlap,
+                    span,
+                    local: LocalParams::from_mapping(&m),
+                },
+                StitchParams {
+                    cutoff: m.cluster_cutoff,
+                    neighbours: m.neighbours,
+                },
+            )
+        }
+    };
+    if let Some(n) = args.windows {
+        if n == 0 {
+            return Err(input(anyhow::anyhow!("--windows must be at least 1")));
+        }
+        cfg.windows = n;
+    }
+    if let Some(o) = args.overlap {
+        if !(o.is_finite() && o >= 0.0) {
+            return Err(input(anyhow::anyhow!(
+                "--overlap must be a non-negative number of seconds, got {o}"
+            )));
+        }
+        cfg.overlap = o;
+    }
+    let mut timings = Timings::default();
+    let seed = world.as_ref().map(|w| w.seed);
+    let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(input)?;
+    write_maps(&args.run_dir, &log, &mapped)?;
+    print!("{}", mapped.summary.table());
+    Ok(())
+}
