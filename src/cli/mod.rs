@@ -2,6 +2,7 @@
 //! code comes from the failure's kind, never from a panic.
 
 mod check;
+mod eval;
 mod map;
 mod persistence;
 mod run;
@@ -77,6 +78,8 @@ enum Command {
     Map(map::MapArgs),
     /// Simulate, map, stitch and evaluate a world in one go.
     Run(run::RunArgs),
+    /// Accuracy over many worlds, seeds and parameter values, in parallel.
+    Eval(eval::EvalArgs),
     /// Vietoris–Rips persistence diagram (H0, H1) of a CSV of points or distances.
     Persistence(persistence::PersistenceArgs),
 }
@@ -88,6 +91,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Map(args) => map::run(&args),
         Command::Run(args) => run::run(&args),
+        Command::Eval(args) => eval::run(&args),
         Command::Persistence(a) => persistence::run(a),
     };
     match result {

@@ -6,6 +6,9 @@
 //! - [`fidelity`]: rank correlation of the encounter metric with true distances
 //!   ([`spearman`]) and the Procrustes error of the embedding ([`procrustes_error`]).
 
+//! - [`campaign`]: `swarmmap eval`, many worlds × parameters × seeds in parallel.
+
+pub mod campaign;
 pub mod fidelity;
 pub mod truth;
 

@@ -1,0 +1,137 @@
+//! `swarmmap eval WORLD... --seeds 1..20 [--jobs N] [--set path=v1,v2]... [--out DIR]`:
+//! accuracy over many worlds, seeds and parameter values.
+
+use super::{Failure, input};
+use anyhow::{Context, anyhow};
+use clap::Args;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use swarmmap::eval::campaign::{Job, combinations, csv, run_campaign, table};
+use swarmmap::io::write_atomic;
+use swarmmap::world::WorldSpec;
+
+/// Options of `swarmmap eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// World files (RON).
+    #[arg(required = true)]
+    pub worlds: Vec<PathBuf>,
+    /// Seeds: `A..B` (inclusive), or a comma-separated list.
+    #[arg(long, default_value = "1..20")]
+    pub seeds: String,
+    /// Runs in parallel (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Sweep a world field over values, e.g. `--set swarm.detection_radius=0.01,0.03,0.1`
+    /// (repeatable; every combination is run).
+    #[arg(long = "set", value_name = "PATH=V1[,V2...]")]
+    pub set: Vec<String>,
+    /// Campaign directory: `runs/` (one file per finished run, reused on rerun) and
+    /// `eval.csv` (default: `runs/eval`).
+    #[arg(long, default_value = "runs/eval")]
+    pub out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Parses `A..B` (inclusive) or `a,b,c`.
+pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
+    let bad = || format!("--seeds `{s}` is not `A..B` or a list like `1,2,5`");
+    if let Some((a, b)) = s.split_once("..") {
+        let (a, b): (u64, u64) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim()
+                .trim_start_matches('=')
+                .parse()
+                .map_err(|_| bad())?,
+        );
+        if a > b {
+            return Err(format!("--seeds {s}: the range is empty (start after end)"));
+        }
+        Ok((a..=b).collect())
+    } else {
+        s.split(',')
+            .map(|x| x.trim().parse().map_err(|_| bad()))
+            .collect()
+    }
+}
+
+pub fn run(args: &EvalArgs) -> Result<(), Failure> {
+    let seeds = parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
+    let mut sweeps = Vec::new();
+    for s in &args.set {
+        let (path, values) = s.split_once('=').ok_or_else(|| {
+            input(anyhow!(
+                "--set `{s}`: expected PATH=VALUE[,VALUE...], e.g. swarm.agents=100,200"
+            ))
+        })?;
+        let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
+        sweeps.push((path.trim().to_string(), values));
+    }
+    let combos = combinations(&sweeps);
+    // Validate every world × combination up front, so a typo fails at once, not per run.
+    for w in &args.worlds {
+        for c in &combos {
+            let mut spec = WorldSpec::load(w).map_err(input)?;
+            for (p, v) in c {
+                swarmmap::world::apply_override(&mut spec, p, v).map_err(input)?;
+            }
+            spec.check().map_err(input)?;
+        }
+    }
+    let mut jobs = Vec::new();
+    for w in &args.worlds {
+        for c in &combos {
+            for &seed in &seeds {
+                jobs.push(Job {
+                    world: w.clone(),
+                    overrides: c.clone(),
+                    seed,
+                });
+            }
+        }
+    }
+    let threads = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let bar = super::progress_bar(args.quiet, "evaluating");
+    if let Some(b) = &bar {
+        b.set_length(jobs.len() as u64);
+    }
+    let failures = Mutex::new(Vec::new());
+    let tick = |r: &swarmmap::eval::campaign::RunRecord| {
+        if let Some(e) = &r.error
+            && let Ok(mut f) = failures.lock()
+        {
+            f.push(format!("{} seed {}: {e}", r.world_file, r.seed));
+        }
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    };
+    let records = run_campaign(&jobs, &args.out, threads.max(1), &tick)
+        .with_context(|| format!("running the campaign in {}", args.out.display()))?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let csv_path = args.out.join("eval.csv");
+    write_atomic(&csv_path, csv(&records).as_bytes())
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    print!("{}", table(&records));
+    println!("per-run rows: {}", csv_path.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_seeds;
+
+    #[test]
+    fn seeds_parse() {
+        assert_eq!(parse_seeds("1..3").unwrap(), vec![1, 2, 3]);
+        assert_eq!(parse_seeds("4,7").unwrap(), vec![4, 7]);
+        assert!(parse_seeds("3..1").is_err());
+        assert!(parse_seeds("x").is_err());
+    }
+}
