@@ -8,6 +8,7 @@
 
 //! - [`campaign`]: `swarmmap eval`, many worlds × parameters × seeds in parallel.
 
+pub mod calibrate;
 pub mod campaign;
 pub mod fidelity;
 pub mod truth;

@@ -1,0 +1,182 @@
+//! Fitting the robust-feature classifier (`swarmmap calibrate`; paper §"Topological
+//! Feature Extraction", which classifies features "using statistical learning techniques").
+//!
+//! Training data: for every window of every training run, the persistence diagram of each
+//! real component with its sampling scale, and the window's true (β0, β1). The model has
+//! three thresholds (see [`crate::mapping::classify`]); we fit them by exhaustive search over
+//! a grid, maximising the share of windows whose (β0, β1) both equal the truth, and break ties
+//! towards the middle of the best plateau, which keeps the margin to either failure mode
+//! (missing a hole, inventing one) as wide as the data allow. With three parameters and
+//! thousands of windows, a grid is exact enough and cannot get stuck.
+
+use crate::mapping::classify::{Classifier, Feature, sampling_scale};
+use crate::mapping::local::LocalMap;
+use serde::Serialize;
+
+/// One training window: its components' diagrams and its truth.
+#[derive(Debug, Clone)]
+pub struct Sample {
+    /// Per component: its features.
+    pub components: Vec<Vec<Feature>>,
+    pub truth: [usize; 2],
+}
+
+impl Sample {
+    /// The training sample of a local map with known truth.
+    pub fn from_map(map: &LocalMap, truth: [usize; 2]) -> Self {
+        Self {
+            components: map
+                .components
+                .iter()
+                .map(|c| {
+                    c.diagram
+                        .iter()
+                        .map(|b| Feature {
+                            dim: b.dim,
+                            birth: b.birth,
+                            death: b.death.unwrap_or(f64::INFINITY),
+                        })
+                        .collect()
+                })
+                .collect(),
+            truth,
+        }
+    }
+
+    fn betti(&self, c: &Classifier) -> [usize; 2] {
+        self.components.iter().fold([0, 0], |acc, f| {
+            let b = c.betti(f);
+            [acc[0] + b[0], acc[1] + b[1]]
+        })
+    }
+}
+
+/// The result of a fit.
+#[derive(Debug, Clone, Serialize)]
+pub struct Fit {
+    pub classifier: Classifier,
+    /// Share of training windows with both Betti numbers right.
+    pub accuracy: f64,
+    /// Share with β0 right, and with β1 right.
+    pub b0_accuracy: f64,
+    pub b1_accuracy: f64,
+    pub windows: usize,
+}
+
+/// The grid of each threshold.
+fn grid(lo: f64, hi: f64, step: f64) -> Vec<f64> {
+    let n = ((hi - lo) / step).round() as usize;
+    (0..=n).map(|k| lo + k as f64 * step).collect()
+}
+
+/// Fits the three thresholds on `samples`. β0 and β1 are decided by disjoint parameters
+/// (`h0_ratio`; `h1_ratio` and `h1_span`), so they are fitted separately and combined; the
+/// reported accuracy is that of the combination.
+pub fn fit(samples: &[Sample]) -> Option<Fit> {
+    if samples.is_empty() {
+        return None;
+    }
+    // Precompute the sampling scale of each component once.
+    let scaled: Vec<Vec<(f64, &Vec<Feature>)>> = samples
+        .iter()
+        .map(|s| s.components.iter().map(|f| (sampling_scale(f), f)).collect())
+        .collect();
+    let count = |pick: &dyn Fn(&Feature, f64) -> bool, dim: usize| -> usize {
+        samples
+            .iter()
+            .zip(&scaled)
+            .filter(|(s, comps)| {
+                let b: usize = comps
+                    .iter()
+                    .map(|(sigma, fs)| {
+                        fs.iter()
+                            .filter(|f| f.dim == dim && pick(f, *sigma))
+                            .count()
+                    })
+                    .sum();
+                b == s.truth[dim]
+            })
+            .count()
+    };
+    let base = Classifier {
+        h0_ratio: 0.0,
+        h1_ratio: 0.0,
+        h1_span: 0.0,
+    };
+    let best_middle = |scores: Vec<(Vec<f64>, usize)>| -> Vec<f64> {
+        let top = scores.iter().map(|s| s.1).max().unwrap_or(0);
+        let winners: Vec<&Vec<f64>> = scores.iter().filter(|s| s.1 == top).map(|s| &s.0).collect();
+        winners[winners.len() / 2].clone()
+    };
+    let h0: Vec<(Vec<f64>, usize)> = grid(1.0, 30.0, 0.25)
+        .into_iter()
+        .map(|r| {
+            let c = Classifier { h0_ratio: r, ..base };
+            (vec![r], count(&|f, s| c.robust(f, s), 0))
+        })
+        .collect();
+    let h0_ratio = best_middle(h0)[0];
+    let mut h1 = Vec::new();
+    for r in grid(1.0, 8.0, 0.1) {
+        for span in grid(0.0, 20.0, 0.25) {
+            let c = Classifier {
+                h1_ratio: r,
+                h1_span: span,
+                ..base
+            };
+            h1.push((vec![r, span], count(&|f, s| c.robust(f, s), 1)));
+        }
+    }
+    let best = best_middle(h1);
+    let classifier = Classifier {
+        h0_ratio,
+        h1_ratio: best[0],
+        h1_span: best[1],
+    };
+    let n = samples.len() as f64;
+    let (mut ok, mut ok0, mut ok1) = (0, 0, 0);
+    for s in samples {
+        let b = s.betti(&classifier);
+        ok += usize::from(b == s.truth);
+        ok0 += usize::from(b[0] == s.truth[0]);
+        ok1 += usize::from(b[1] == s.truth[1]);
+    }
+    Some(Fit {
+        classifier,
+        accuracy: ok as f64 / n,
+        b0_accuracy: ok0 as f64 / n,
+        b1_accuracy: ok1 as f64 / n,
+        windows: samples.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f(dim: usize, birth: f64, death: f64) -> Feature {
+        Feature { dim, birth, death }
+    }
+
+    /// Windows whose real holes have ratio 4 and noise ratio ≤ 2: the fit must separate them.
+    #[test]
+    fn fit_separates_signal_from_noise() {
+        let noise = |k: f64| {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            v.push(f(1, 1.0, 1.5 + 0.1 * k));
+            v.push(f(1, 2.0, 3.0));
+            v
+        };
+        let mut samples = Vec::new();
+        for k in 0..5 {
+            let mut with_hole = noise(k as f64);
+            with_hole.push(f(1, 1.0, 4.0 + k as f64));
+            samples.push(Sample { components: vec![with_hole], truth: [1, 1] });
+            samples.push(Sample { components: vec![noise(k as f64)], truth: [1, 0] });
+        }
+        let fit = fit(&samples).unwrap();
+        assert_eq!(fit.accuracy, 1.0, "{fit:?}");
+        assert!(fit.classifier.h1_ratio > 2.0 && fit.classifier.h1_ratio <= 4.0);
+    }
+}
