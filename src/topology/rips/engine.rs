@@ -217,22 +217,35 @@ fn spanning_forest<M: Metric>(m: &M, t: f64) -> (Vec<Edge>, usize) {
     (tree, components)
 }
 
-/// Oldest cofacet of `{a > b}` (value `d`) with value ≤ `t`, scanning apexes from the top;
-/// stops at the first cofacet of value `d` (it is the oldest: values are ≥ `d` and the
-/// colex index grows with the apex).
+/// Oldest cofacet of `{a > b}` (value `d`) with value ≤ `t`. Every cofacet has value
+/// ≥ `d` and the colex index grows with the apex `k`, so if some `k` has both other edges
+/// ≤ `d`, the oldest cofacet is the one with the largest such `k`; this is found by
+/// scanning down from the top in blocks whose test the compiler can vectorise. Otherwise
+/// (rare: relative-neighbourhood edges) a full scan finds the minimum value.
 #[inline]
 fn oldest_cofacet<M: Metric>(m: &M, a: usize, b: usize, d: f64, t: f64) -> Option<Tri> {
+    const W: usize = 16;
     let n = m.len();
+    let mut hi = n;
+    while hi > 0 {
+        let lo = hi.saturating_sub(W);
+        let mut any = false;
+        for k in lo..hi {
+            any |= m.value(a, k).max(m.value(b, k)) <= d;
+        }
+        if any {
+            for k in (lo..hi).rev() {
+                if k != a && k != b && m.value(a, k).max(m.value(b, k)) <= d {
+                    return Some(Tri::new(d, a, b, k));
+                }
+            }
+        }
+        hi = lo;
+    }
     let mut best: Option<(f64, usize)> = None;
     for k in (0..n).rev() {
-        if k == a || k == b {
-            continue;
-        }
         let x = m.value(a, k).max(m.value(b, k));
-        if x <= d {
-            return Some(Tri::new(d, a, b, k));
-        }
-        if x <= t && best.is_none_or(|(bx, _)| x < bx) {
+        if k != a && k != b && x <= t && best.is_none_or(|(bx, _)| x < bx) {
             best = Some((x, k));
         }
     }
@@ -281,15 +294,13 @@ impl<M: Metric> Reducer<'_, M> {
         self.pivots.get(tau).map(|&j| Owner::Reduced(j))
     }
 
-    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge) {
+    /// Pushes the cofacets of `e` with value ≤ `bound` (≤ the threshold).
+    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge, bound: f64) {
         let (a, b) = (e.a as usize, e.b as usize);
         let d = e.value();
         for k in 0..self.m.len() {
-            if k == a || k == b {
-                continue;
-            }
             let x = d.max(self.m.value(a, k)).max(self.m.value(b, k));
-            if x <= self.t {
+            if x <= bound && k != a && k != b {
                 heap.push(Tri::new(x, a, b, k));
             }
         }
@@ -304,31 +315,47 @@ impl<M: Metric> Reducer<'_, M> {
             self.columns.push(vec![e]);
             return Some(p0);
         }
-        heap.clear();
-        self.push_coboundary(heap, &e);
-        let mut v = vec![e];
-        loop {
-            let Some(p) = pop_pivot(heap) else {
-                return None;
-            };
-            match self.owner(&p) {
-                Some(Owner::Apparent(f)) => {
-                    self.push_coboundary(heap, &f);
-                    v.push(f);
-                }
-                Some(Owner::Reduced(j)) => {
-                    let col = std::mem::take(&mut self.columns[j]);
-                    for f in &col {
-                        self.push_coboundary(heap, f);
+        // Truncated reduction: only cofacets with value ≤ `bound` are generated. The
+        // truncated working column is the true one restricted to values ≤ `bound`, so
+        // while it is non-empty its pivot is the true pivot; if it empties, the bound is
+        // raised and the column reduced again. Most deaths are near their births, so this
+        // spares generating (and heaping) the ~n cofacets of every added column.
+        let mut bound = if p0.value() > 0.0 {
+            (4.0 * p0.value()).min(self.t)
+        } else {
+            self.t
+        };
+        'attempt: loop {
+            heap.clear();
+            self.push_coboundary(heap, &e, bound);
+            let mut v = vec![e];
+            loop {
+                let Some(p) = pop_pivot(heap) else {
+                    if bound >= self.t {
+                        return None;
                     }
-                    v.extend_from_slice(&col);
-                    self.columns[j] = col;
-                }
-                None => {
-                    canonical(&mut v);
-                    self.pivots.insert(p, self.columns.len());
-                    self.columns.push(v);
-                    return Some(p);
+                    bound = (4.0 * bound).min(self.t);
+                    continue 'attempt;
+                };
+                match self.owner(&p) {
+                    Some(Owner::Apparent(f)) => {
+                        self.push_coboundary(heap, &f, bound);
+                        v.push(f);
+                    }
+                    Some(Owner::Reduced(j)) => {
+                        let col = std::mem::take(&mut self.columns[j]);
+                        for f in &col {
+                            self.push_coboundary(heap, f, bound);
+                        }
+                        v.extend_from_slice(&col);
+                        self.columns[j] = col;
+                    }
+                    None => {
+                        canonical(&mut v);
+                        self.pivots.insert(p, self.columns.len());
+                        self.columns.push(v);
+                        return Some(p);
+                    }
                 }
             }
         }
