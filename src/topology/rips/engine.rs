@@ -294,13 +294,13 @@ impl<M: Metric> Reducer<'_, M> {
         self.pivots.get(tau).map(|&j| Owner::Reduced(j))
     }
 
-    /// Pushes the cofacets of `e` with value ≤ `bound` (≤ the threshold).
-    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge, bound: f64) {
+    /// Pushes the cofacets of `e` with value in `(lo, hi]` (`hi` ≤ the threshold).
+    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge, lo: f64, hi: f64) {
         let (a, b) = (e.a as usize, e.b as usize);
         let d = e.value();
         for k in 0..self.m.len() {
             let x = d.max(self.m.value(a, k)).max(self.m.value(b, k));
-            if x <= bound && k != a && k != b {
+            if x <= hi && x > lo && k != a && k != b {
                 heap.push(Tri::new(x, a, b, k));
             }
         }
@@ -315,69 +315,90 @@ impl<M: Metric> Reducer<'_, M> {
             self.columns.push(vec![e]);
             return Some(p0);
         }
-        // Truncated reduction: only cofacets with value ≤ `bound` are generated. The
-        // truncated working column is the true one restricted to values ≤ `bound`, so
-        // while it is non-empty its pivot is the true pivot; if it empties, the bound is
-        // raised and the column reduced again. Most deaths are near their births, so this
-        // spares generating (and heaping) the ~n cofacets of every added column.
+        // Truncated reduction: the heap holds the working column restricted to values
+        // ≤ `bound`, so while it is non-empty its top is the true pivot. When it empties,
+        // the bound is raised and the missing cofacets of the reduction-matrix column are
+        // pushed. Most deaths are close to their births, so most columns never generate
+        // (or heap) the ~n cofacets of every added column; long bars pay once per raise
+        // for a scan without pushes.
         let mut bound = if p0.value() > 0.0 {
-            (4.0 * p0.value()).min(self.t)
+            (2.0 * p0.value()).min(self.t)
         } else {
             self.t
         };
-        'attempt: loop {
-            heap.clear();
-            self.push_coboundary(heap, &e, bound);
-            let mut v = vec![e];
-            loop {
-                let Some(p) = pop_pivot(heap) else {
-                    if bound >= self.t {
-                        return None;
+        heap.clear();
+        self.push_coboundary(heap, &e, f64::NEG_INFINITY, bound);
+        let mut v = vec![e];
+        let mut compact_at = COMPACT_MIN;
+        loop {
+            if heap.len() > compact_at {
+                compact(heap);
+                compact_at = COMPACT_MIN.max(2 * heap.len());
+            }
+            let Some(p) = pop_pivot(heap) else {
+                if bound >= self.t {
+                    return None;
+                }
+                let lo = bound;
+                bound = (2.0 * bound).min(self.t);
+                canonical(&mut v);
+                for f in &v {
+                    self.push_coboundary(heap, f, lo, bound);
+                }
+                continue;
+            };
+            match self.owner(&p) {
+                Some(Owner::Apparent(f)) => {
+                    self.push_coboundary(heap, &f, f64::NEG_INFINITY, bound);
+                    v.push(f);
+                }
+                Some(Owner::Reduced(j)) => {
+                    let col = std::mem::take(&mut self.columns[j]);
+                    for f in &col {
+                        self.push_coboundary(heap, f, f64::NEG_INFINITY, bound);
                     }
-                    bound = (4.0 * bound).min(self.t);
-                    continue 'attempt;
-                };
-                match self.owner(&p) {
-                    Some(Owner::Apparent(f)) => {
-                        self.push_coboundary(heap, &f, bound);
-                        v.push(f);
-                    }
-                    Some(Owner::Reduced(j)) => {
-                        let col = std::mem::take(&mut self.columns[j]);
-                        for f in &col {
-                            self.push_coboundary(heap, f, bound);
-                        }
-                        v.extend_from_slice(&col);
-                        self.columns[j] = col;
-                    }
-                    None => {
-                        canonical(&mut v);
-                        self.pivots.insert(p, self.columns.len());
-                        self.columns.push(v);
-                        return Some(p);
-                    }
+                    v.extend_from_slice(&col);
+                    self.columns[j] = col;
+                }
+                None => {
+                    canonical(&mut v);
+                    self.pivots.insert(p, self.columns.len());
+                    self.columns.push(v);
+                    return Some(p);
                 }
             }
         }
     }
 }
 
+/// Heap size (entries) below which a working column is never compacted.
+const COMPACT_MIN: usize = 1 << 16;
+
+/// Cancels the pairs of a Z/2 heap column in bulk: a sort is far cheaper than popping each
+/// cancelling pair, and a long column (a big hole) would otherwise heap every cofacet of
+/// every edge added to it.
+fn compact<T: Ord + Copy>(heap: &mut BinaryHeap<T>) {
+    let mut v = std::mem::take(heap).into_vec();
+    canonical(&mut v);
+    *heap = BinaryHeap::from(v);
+}
+
 /// Sorts a Z/2 chain and cancels repeated entries in pairs.
 pub(crate) fn canonical<T: Ord + Copy>(v: &mut Vec<T>) {
     v.sort_unstable();
-    let mut out = Vec::with_capacity(v.len());
-    let mut i = 0;
+    let (mut w, mut i) = (0, 0);
     while i < v.len() {
         let mut j = i;
         while j < v.len() && v[j] == v[i] {
             j += 1;
         }
         if (j - i) % 2 == 1 {
-            out.push(v[i]);
+            v[w] = v[i];
+            w += 1;
         }
         i = j;
     }
-    *v = out;
+    v.truncate(w);
 }
 
 /// Pops the top of a Z/2 heap column, cancelling equal entries in pairs, and leaves the
