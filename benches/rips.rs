@@ -23,9 +23,11 @@ fn bench(c: &mut Criterion) {
                 threads,
                 ..RipsOptions::default()
             };
-            g.bench_with_input(BenchmarkId::new(format!("threads{threads}"), n), &p, |b, p| {
-                b.iter(|| rips_points(p, &opts))
-            });
+            g.bench_with_input(
+                BenchmarkId::new(format!("threads{threads}"), n),
+                &p,
+                |b, p| b.iter(|| rips_points(p, &opts)),
+            );
         }
     }
     let p = uniform(1000, 7);

@@ -5,7 +5,10 @@ use predicates::prelude::*;
 use std::io::Write;
 
 fn fixture(name: &str) -> String {
-    format!("{}/tests/fixtures/persistence/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!(
+        "{}/tests/fixtures/persistence/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
 }
 
 fn cmd() -> Command {
@@ -35,8 +38,12 @@ fn square_with_cycles_and_maxdim0() {
         .args(["persistence", f.path().to_str().unwrap(), "--cycles"])
         .assert()
         .success()
-        .stdout(predicate::str::ends_with("1,1,1.4142135623730951,0-1;0-3;1-2;2-3\n"))
-        .stdout(predicate::str::starts_with("dim,birth,death,cycle\n0,0,1,\n"));
+        .stdout(predicate::str::ends_with(
+            "1,1,1.4142135623730951,0-1;0-3;1-2;2-3\n",
+        ))
+        .stdout(predicate::str::starts_with(
+            "dim,birth,death,cycle\n0,0,1,\n",
+        ));
     cmd()
         .args(["persistence", f.path().to_str().unwrap(), "--maxdim", "0"])
         .assert()
@@ -47,7 +54,11 @@ fn square_with_cycles_and_maxdim0() {
 #[test]
 fn distance_matrix_and_threshold() {
     let out = cmd()
-        .args(["persistence", &fixture("graph_metric_150.dist.csv"), "--distance-matrix"])
+        .args([
+            "persistence",
+            &fixture("graph_metric_150.dist.csv"),
+            "--distance-matrix",
+        ])
         .assert()
         .success()
         .get_output()
@@ -57,7 +68,13 @@ fn distance_matrix_and_threshold() {
     assert_eq!(text.lines().filter(|l| l.starts_with("0,")).count(), 150);
     let f = temp_csv("0,1,3\n1,0,1\n3,1,0\n");
     cmd()
-        .args(["persistence", f.path().to_str().unwrap(), "--distance-matrix", "--threshold", "0.5"])
+        .args([
+            "persistence",
+            f.path().to_str().unwrap(),
+            "--distance-matrix",
+            "--threshold",
+            "0.5",
+        ])
         .assert()
         .success()
         .stdout("dim,birth,death\n0,0,inf\n0,0,inf\n0,0,inf\n");
@@ -76,15 +93,43 @@ fn bad(text: &str, extra: &[&str], msg: &str) {
 
 #[test]
 fn bad_files_name_the_line_and_exit_2() {
-    bad("0,0\n1,0\n1\n", &[], ":3: row has 1 columns but line 1 has 2");
+    bad(
+        "0,0\n1,0\n1\n",
+        &[],
+        ":3: row has 1 columns but line 1 has 2",
+    );
     bad("0,0\n1,x\n", &[], ":2: column 2: 'x' is not a number");
-    bad("0,0\n1,nan\n", &[], ":2: coordinate 1 of point 1 is not a finite number");
+    bad(
+        "0,0\n1,nan\n",
+        &[],
+        ":2: coordinate 1 of point 1 is not a finite number",
+    );
     bad("", &[], "no rows");
-    bad("0,1\n2,0\n", &["--distance-matrix"], ":1: entries (0, 1) = 1 and (1, 0) = 2 differ");
-    bad("0,-1\n-1,0\n", &["--distance-matrix"], ":1: entry (0, 1) is -1");
-    bad("0,1,2\n1,0,1\n", &["--distance-matrix"], ":1: row 0 has 3 entries but the matrix has 2 rows");
-    bad("0,0\n", &["--maxdim", "2"], "homology dimension 2 is not supported");
-    bad("0,0\n", &["--threshold", "-1"], "threshold -1 is not a finite non-negative distance");
+    bad(
+        "0,1\n2,0\n",
+        &["--distance-matrix"],
+        ":1: entries (0, 1) = 1 and (1, 0) = 2 differ",
+    );
+    bad(
+        "0,-1\n-1,0\n",
+        &["--distance-matrix"],
+        ":1: entry (0, 1) is -1",
+    );
+    bad(
+        "0,1,2\n1,0,1\n",
+        &["--distance-matrix"],
+        ":1: row 0 has 3 entries but the matrix has 2 rows",
+    );
+    bad(
+        "0,0\n",
+        &["--maxdim", "2"],
+        "homology dimension 2 is not supported",
+    );
+    bad(
+        "0,0\n",
+        &["--threshold", "-1"],
+        "threshold -1 is not a finite non-negative distance",
+    );
 }
 
 #[test]
@@ -93,5 +138,7 @@ fn missing_file_is_not_an_input_error() {
         .args(["persistence", "/nonexistent/points.csv"])
         .assert()
         .code(1)
-        .stderr(predicate::str::contains("cannot read /nonexistent/points.csv"));
+        .stderr(predicate::str::contains(
+            "cannot read /nonexistent/points.csv",
+        ));
 }

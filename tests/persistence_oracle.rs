@@ -27,8 +27,11 @@ fn oracle(n: usize, d: &dyn Fn(usize, usize) -> f64, t: f64) -> Vec<Vec<(f64, f6
     }
     s.retain(|x| x.0 <= t);
     s.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let pos: std::collections::HashMap<Vec<usize>, usize> =
-        s.iter().enumerate().map(|(k, x)| (x.2.clone(), k)).collect();
+    let pos: std::collections::HashMap<Vec<usize>, usize> = s
+        .iter()
+        .enumerate()
+        .map(|(k, x)| (x.2.clone(), k))
+        .collect();
     let mut cols: Vec<Vec<usize>> = s
         .iter()
         .map(|x| {
@@ -37,7 +40,12 @@ fn oracle(n: usize, d: &dyn Fn(usize, usize) -> f64, t: f64) -> Vec<Vec<(f64, f6
             } else {
                 (0..x.2.len())
                     .map(|drop| {
-                        let f: Vec<usize> = x.2.iter().enumerate().filter(|&(q, _)| q != drop).map(|(_, &v)| v).collect();
+                        let f: Vec<usize> =
+                            x.2.iter()
+                                .enumerate()
+                                .filter(|&(q, _)| q != drop)
+                                .map(|(_, &v)| v)
+                                .collect();
                         pos[&f]
                     })
                     .collect()
@@ -133,20 +141,36 @@ fn compare(n: usize, d: &dyn Fn(usize, usize) -> f64, got: &Diagram, t: f64) {
     let want = oracle(n, d, t);
     for dim in 0..2 {
         // Oracle values are exact copies of the inputs, so only exact-tie noise can differ.
-        assert_same(&bars(got, dim), &want[dim], 1e-12, &format!("H{dim} (n = {n}, t = {t})"));
+        assert_same(
+            &bars(got, dim),
+            &want[dim],
+            1e-12,
+            &format!("H{dim} (n = {n}, t = {t})"),
+        );
     }
     for b in got.dim(1) {
         check_cycle(b, d);
         let z = b.cycle.as_ref().unwrap();
-        assert!(!is_boundary(n, d, z, b.birth), "cycle of {b:?} is a boundary at its birth");
+        assert!(
+            !is_boundary(n, d, z, b.birth),
+            "cycle of {b:?} is a boundary at its birth"
+        );
         if b.death.is_finite() {
-            assert!(is_boundary(n, d, z, b.death), "cycle of {b:?} survives its death");
+            assert!(
+                is_boundary(n, d, z, b.death),
+                "cycle of {b:?} survives its death"
+            );
         }
     }
 }
 
 fn opts(t: Option<f64>) -> RipsOptions {
-    RipsOptions { maxdim: 1, threshold: t, cycles: true, threads: 1 }
+    RipsOptions {
+        maxdim: 1,
+        threshold: t,
+        cycles: true,
+        threads: 1,
+    }
 }
 
 proptest! {

@@ -20,7 +20,9 @@ const CASES: [&str; 7] = [
 ];
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/persistence").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/persistence")
+        .join(name)
 }
 
 fn read_csv(name: &str, header: bool) -> Vec<Vec<f64>> {
@@ -28,7 +30,11 @@ fn read_csv(name: &str, header: bool) -> Vec<Vec<f64>> {
     text.lines()
         .skip(usize::from(header))
         .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|x| x.trim().parse::<f64>().unwrap()).collect())
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.trim().parse::<f64>().unwrap())
+                .collect()
+        })
         .collect()
 }
 
@@ -40,9 +46,13 @@ enum Input {
 impl Input {
     fn load(case: &str) -> Self {
         if fixture(&format!("{case}.points.csv")).exists() {
-            Input::Points(PointCloud::from_rows(&read_csv(&format!("{case}.points.csv"), false)).unwrap())
+            Input::Points(
+                PointCloud::from_rows(&read_csv(&format!("{case}.points.csv"), false)).unwrap(),
+            )
         } else {
-            Input::Matrix(DistanceMatrix::from_full(&read_csv(&format!("{case}.dist.csv"), false)).unwrap())
+            Input::Matrix(
+                DistanceMatrix::from_full(&read_csv(&format!("{case}.dist.csv"), false)).unwrap(),
+            )
         }
     }
     fn rips(&self, o: &RipsOptions) -> Diagram {
@@ -74,7 +84,12 @@ fn every_reference_case_matches() {
         let input = Input::load(case);
         let d = input.rips(&RipsOptions::default());
         for dim in 0..2 {
-            assert_same(&bars(&d, dim), &reference(case, dim), 1e-9, &format!("{case} H{dim}"));
+            assert_same(
+                &bars(&d, dim),
+                &reference(case, dim),
+                1e-9,
+                &format!("{case} H{dim}"),
+            );
         }
         assert_eq!(d.dim(0).filter(|b| b.is_essential()).count(), 1, "{case}");
         assert_eq!(d.dim(1).filter(|b| b.is_essential()).count(), 0, "{case}");
@@ -84,8 +99,15 @@ fn every_reference_case_matches() {
 #[test]
 fn h0_deaths_are_single_linkage_heights() {
     for case in CASES {
-        let d = Input::load(case).rips(&RipsOptions { maxdim: 0, ..Default::default() });
-        let mut deaths: Vec<f64> = d.dim(0).map(|b| b.death).filter(|x| x.is_finite()).collect();
+        let d = Input::load(case).rips(&RipsOptions {
+            maxdim: 0,
+            ..Default::default()
+        });
+        let mut deaths: Vec<f64> = d
+            .dim(0)
+            .map(|b| b.death)
+            .filter(|x| x.is_finite())
+            .collect();
         deaths.sort_by(f64::total_cmp);
         let mut heights: Vec<f64> = read_csv(&format!("{case}.single_linkage.csv"), true)
             .into_iter()
@@ -95,7 +117,10 @@ fn h0_deaths_are_single_linkage_heights() {
         heights.sort_by(f64::total_cmp);
         assert_eq!(deaths.len(), heights.len(), "{case}");
         for (a, b) in deaths.iter().zip(&heights) {
-            assert!(persistence_common::close(*a, *b, 1e-9), "{case}: {a} vs {b}");
+            assert!(
+                persistence_common::close(*a, *b, 1e-9),
+                "{case}: {a} vs {b}"
+            );
         }
     }
 }
@@ -105,7 +130,10 @@ fn representative_cycles_on_reference_cases() {
     for case in CASES {
         let input = Input::load(case);
         let plain = input.rips(&RipsOptions::default());
-        let d = input.rips(&RipsOptions { cycles: true, ..Default::default() });
+        let d = input.rips(&RipsOptions {
+            cycles: true,
+            ..Default::default()
+        });
         // Asking for cycles does not change the bars.
         let strip = |d: &Diagram| -> Vec<(usize, f64, f64)> {
             d.bars.iter().map(|b| (b.dim, b.birth, b.death)).collect()
@@ -121,8 +149,16 @@ fn representative_cycles_on_reference_cases() {
 #[test]
 fn one_thread_and_many_threads_agree_bitwise() {
     let input = Input::load("torus3d_400");
-    let one = input.rips(&RipsOptions { threads: 1, cycles: true, ..Default::default() });
-    let two = input.rips(&RipsOptions { threads: 2, cycles: true, ..Default::default() });
+    let one = input.rips(&RipsOptions {
+        threads: 1,
+        cycles: true,
+        ..Default::default()
+    });
+    let two = input.rips(&RipsOptions {
+        threads: 2,
+        cycles: true,
+        ..Default::default()
+    });
     assert_eq!(one, two);
 }
 
@@ -130,7 +166,10 @@ fn one_thread_and_many_threads_agree_bitwise() {
 fn explicit_large_threshold_equals_enclosing_radius() {
     let input = Input::load("two_circles_300");
     let a = input.rips(&RipsOptions::default());
-    let b = input.rips(&RipsOptions { threshold: Some(1e9), ..Default::default() });
+    let b = input.rips(&RipsOptions {
+        threshold: Some(1e9),
+        ..Default::default()
+    });
     assert_eq!(a, b);
 }
 
@@ -146,11 +185,18 @@ fn low_threshold_makes_circle_essential() {
         .unwrap()
         .clone();
     let t = 0.5 * (big.birth + big.death);
-    let d = input.rips(&RipsOptions { threshold: Some(t), cycles: true, ..Default::default() });
+    let d = input.rips(&RipsOptions {
+        threshold: Some(t),
+        cycles: true,
+        ..Default::default()
+    });
     let ess: Vec<_> = d.dim(1).filter(|b| b.is_essential()).collect();
     assert_eq!(ess.len(), 1);
     assert_eq!(ess[0].birth, big.birth);
     check_cycle(ess[0], |i, j| input.len(i, j));
-    let tiny = input.rips(&RipsOptions { threshold: Some(0.0), ..Default::default() });
+    let tiny = input.rips(&RipsOptions {
+        threshold: Some(0.0),
+        ..Default::default()
+    });
     assert_eq!(tiny.dim(0).filter(|b| b.is_essential()).count(), 100);
 }

@@ -27,7 +27,10 @@ pub(crate) fn representatives<M: Metric>(m: &M, raw: &Raw) -> HashMap<Edge, Vec<
     let paired = |e: &Edge| -> Option<(Tri, bool)> {
         let k = raw.apex[e.index()];
         if k < TREE {
-            Some((Tri::new(e.value(), e.a as usize, e.b as usize, k as usize), true))
+            Some((
+                Tri::new(e.value(), e.a as usize, e.b as usize, k as usize),
+                true,
+            ))
         } else {
             by_edge.get(e).map(|t| (*t, false))
         }

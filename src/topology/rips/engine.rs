@@ -19,7 +19,7 @@
 //! 4. **Cohomology reduction** (Bauer 2021, §3) of the remaining edges in reverse
 //!    filtration order, with the implicit coboundary (cofacets enumerated from the points,
 //!    never stored), the emergent-pair shortcut (a column whose oldest cofacet is nobody's
-//!    pivot is already reduced), and a binary heap as the working column; reduced columns
+//!    pivot is already reduced), and a radix heap as the working column (`column.rs`); reduced columns
 //!    are kept as their few reduction-matrix entries and their coboundaries regenerated.
 //!
 //! The filtration is simplexwise: edges by `(value, colex index descending)`, triangles by
@@ -34,6 +34,7 @@ use std::collections::{BinaryHeap, HashMap};
 
 use rayon::prelude::*;
 
+use super::column::Column;
 use super::metric::Metric;
 
 /// Apex marker: the edge is not in an apparent pair (or is beyond the threshold).
@@ -295,7 +296,7 @@ impl<M: Metric> Reducer<'_, M> {
     }
 
     /// Pushes the cofacets of `e` with value in `(lo, hi]` (`hi` ≤ the threshold).
-    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge, lo: f64, hi: f64) {
+    fn push_coboundary(&self, heap: &mut Column, e: &Edge, lo: f64, hi: f64) {
         let (a, b) = (e.a as usize, e.b as usize);
         let d = e.value();
         for k in 0..self.m.len() {
@@ -307,7 +308,7 @@ impl<M: Metric> Reducer<'_, M> {
     }
 
     /// Reduces the column of `e` (whose oldest cofacet is `p0`); returns its pivot.
-    fn reduce(&mut self, e: Edge, p0: Option<Tri>, heap: &mut BinaryHeap<Tri>) -> Option<Tri> {
+    fn reduce(&mut self, e: Edge, p0: Option<Tri>, heap: &mut Column) -> Option<Tri> {
         let p0 = p0?;
         if self.owner(&p0).is_none() {
             // Emergent pair: the unreduced column already has a fresh pivot.
@@ -332,10 +333,10 @@ impl<M: Metric> Reducer<'_, M> {
         let mut compact_at = COMPACT_MIN;
         loop {
             if heap.len() > compact_at {
-                compact(heap);
+                heap.compact();
                 compact_at = COMPACT_MIN.max(2 * heap.len());
             }
-            let Some(p) = pop_pivot(heap) else {
+            let Some(p) = heap.pivot() else {
                 if bound >= self.t {
                     return None;
                 }
@@ -373,15 +374,6 @@ impl<M: Metric> Reducer<'_, M> {
 
 /// Heap size (entries) below which a working column is never compacted.
 const COMPACT_MIN: usize = 1 << 16;
-
-/// Cancels the pairs of a Z/2 heap column in bulk: a sort is far cheaper than popping each
-/// cancelling pair, and a long column (a big hole) would otherwise heap every cofacet of
-/// every edge added to it.
-fn compact<T: Ord + Copy>(heap: &mut BinaryHeap<T>) {
-    let mut v = std::mem::take(heap).into_vec();
-    canonical(&mut v);
-    *heap = BinaryHeap::from(v);
-}
 
 /// Sorts a Z/2 chain and cancels repeated entries in pairs.
 pub(crate) fn canonical<T: Ord + Copy>(v: &mut Vec<T>) {
@@ -478,7 +470,7 @@ pub(crate) fn compute<M: Metric>(m: &M, t: f64, h1: bool) -> Raw {
         pivots: HashMap::new(),
         columns: Vec::new(),
     };
-    let mut heap = BinaryHeap::new();
+    let mut heap = Column::new();
     let mut pairs = Vec::new();
     let mut reduced = HashMap::new();
     for (e, p0) in todo {

@@ -26,6 +26,7 @@
 //! assert_eq!(d.betti_at(0, 0.5), 4);
 //! ```
 
+mod column;
 mod cycles;
 mod diagram;
 mod engine;
