@@ -21,7 +21,7 @@ impl PointCloud {
         if dim == 0 {
             return Err(MatrixError::ZeroDimension);
         }
-        if coords.len() % dim != 0 {
+        if !coords.len().is_multiple_of(dim) {
             return Err(MatrixError::Ragged {
                 len: coords.len(),
                 dim,

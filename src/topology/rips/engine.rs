@@ -462,7 +462,7 @@ pub(crate) fn compute<M: Metric>(m: &M, t: f64, h1: bool) -> Raw {
         })
         .collect();
     // Reverse filtration order: youngest edge first.
-    todo.sort_unstable_by(|x, y| y.0.cmp(&x.0));
+    todo.sort_unstable_by_key(|x| std::cmp::Reverse(x.0));
     let mut red = Reducer {
         m,
         t,
