@@ -79,7 +79,12 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
     // Precompute the sampling scale of each component once.
     let scaled: Vec<Vec<(f64, &Vec<Feature>)>> = samples
         .iter()
-        .map(|s| s.components.iter().map(|f| (sampling_scale(f), f)).collect())
+        .map(|s| {
+            s.components
+                .iter()
+                .map(|f| (sampling_scale(f), f))
+                .collect()
+        })
         .collect();
     let count = |pick: &dyn Fn(&Feature, f64) -> bool, dim: usize| -> usize {
         samples
@@ -111,7 +116,10 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
     let h0: Vec<(Vec<f64>, usize)> = grid(1.0, 30.0, 0.25)
         .into_iter()
         .map(|r| {
-            let c = Classifier { h0_ratio: r, ..base };
+            let c = Classifier {
+                h0_ratio: r,
+                ..base
+            };
             (vec![r], count(&|f, s| c.robust(f, s), 0))
         })
         .collect();
@@ -172,8 +180,14 @@ mod tests {
         for k in 0..5 {
             let mut with_hole = noise(k as f64);
             with_hole.push(f(1, 1.0, 4.0 + k as f64));
-            samples.push(Sample { components: vec![with_hole], truth: [1, 1] });
-            samples.push(Sample { components: vec![noise(k as f64)], truth: [1, 0] });
+            samples.push(Sample {
+                components: vec![with_hole],
+                truth: [1, 1],
+            });
+            samples.push(Sample {
+                components: vec![noise(k as f64)],
+                truth: [1, 0],
+            });
         }
         let fit = fit(&samples).unwrap();
         assert_eq!(fit.accuracy, 1.0, "{fit:?}");

@@ -47,7 +47,7 @@ pub(crate) fn representatives<M: Metric>(m: &M, raw: &Raw) -> HashMap<Edge, Vec<
 
     // Reduced death triangles, oldest first (`Tri`'s order is "greater = older").
     let mut deaths: Vec<(Tri, Edge)> = raw.reduced.iter().map(|(t, e)| (*t, *e)).collect();
-    deaths.sort_unstable_by(|x, y| y.0.cmp(&x.0));
+    deaths.sort_unstable_by_key(|x| std::cmp::Reverse(x.0));
     let last = deaths.iter().rposition(|(t, e)| nonzero(e, t));
     let mut memo: HashMap<Tri, Vec<Edge>> = HashMap::new();
     let mut out = HashMap::new();

@@ -19,7 +19,7 @@
 //! 4. **Cohomology reduction** (Bauer 2021, §3) of the remaining edges in reverse
 //!    filtration order, with the implicit coboundary (cofacets enumerated from the points,
 //!    never stored), the emergent-pair shortcut (a column whose oldest cofacet is nobody's
-//!    pivot is already reduced), and a binary heap as the working column; reduced columns
+//!    pivot is already reduced), and a radix heap as the working column (`column.rs`); reduced columns
 //!    are kept as their few reduction-matrix entries and their coboundaries regenerated.
 //!
 //! The filtration is simplexwise: edges by `(value, colex index descending)`, triangles by
@@ -34,6 +34,7 @@ use std::collections::{BinaryHeap, HashMap};
 
 use rayon::prelude::*;
 
+use super::column::Column;
 use super::metric::Metric;
 
 /// Apex marker: the edge is not in an apparent pair (or is beyond the threshold).
@@ -217,22 +218,35 @@ fn spanning_forest<M: Metric>(m: &M, t: f64) -> (Vec<Edge>, usize) {
     (tree, components)
 }
 
-/// Oldest cofacet of `{a > b}` (value `d`) with value ≤ `t`, scanning apexes from the top;
-/// stops at the first cofacet of value `d` (it is the oldest: values are ≥ `d` and the
-/// colex index grows with the apex).
+/// Oldest cofacet of `{a > b}` (value `d`) with value ≤ `t`. Every cofacet has value
+/// ≥ `d` and the colex index grows with the apex `k`, so if some `k` has both other edges
+/// ≤ `d`, the oldest cofacet is the one with the largest such `k`; this is found by
+/// scanning down from the top in blocks whose test the compiler can vectorise. Otherwise
+/// (rare: relative-neighbourhood edges) a full scan finds the minimum value.
 #[inline]
 fn oldest_cofacet<M: Metric>(m: &M, a: usize, b: usize, d: f64, t: f64) -> Option<Tri> {
+    const W: usize = 16;
     let n = m.len();
+    let mut hi = n;
+    while hi > 0 {
+        let lo = hi.saturating_sub(W);
+        let mut any = false;
+        for k in lo..hi {
+            any |= m.value(a, k).max(m.value(b, k)) <= d;
+        }
+        if any {
+            for k in (lo..hi).rev() {
+                if k != a && k != b && m.value(a, k).max(m.value(b, k)) <= d {
+                    return Some(Tri::new(d, a, b, k));
+                }
+            }
+        }
+        hi = lo;
+    }
     let mut best: Option<(f64, usize)> = None;
     for k in (0..n).rev() {
-        if k == a || k == b {
-            continue;
-        }
         let x = m.value(a, k).max(m.value(b, k));
-        if x <= d {
-            return Some(Tri::new(d, a, b, k));
-        }
-        if x <= t && best.is_none_or(|(bx, _)| x < bx) {
+        if k != a && k != b && x <= t && best.is_none_or(|(bx, _)| x < bx) {
             best = Some((x, k));
         }
     }
@@ -281,22 +295,20 @@ impl<M: Metric> Reducer<'_, M> {
         self.pivots.get(tau).map(|&j| Owner::Reduced(j))
     }
 
-    fn push_coboundary(&self, heap: &mut BinaryHeap<Tri>, e: &Edge) {
+    /// Pushes the cofacets of `e` with value in `(lo, hi]` (`hi` ≤ the threshold).
+    fn push_coboundary(&self, heap: &mut Column, e: &Edge, lo: f64, hi: f64) {
         let (a, b) = (e.a as usize, e.b as usize);
         let d = e.value();
         for k in 0..self.m.len() {
-            if k == a || k == b {
-                continue;
-            }
             let x = d.max(self.m.value(a, k)).max(self.m.value(b, k));
-            if x <= self.t {
+            if x <= hi && x > lo && k != a && k != b {
                 heap.push(Tri::new(x, a, b, k));
             }
         }
     }
 
     /// Reduces the column of `e` (whose oldest cofacet is `p0`); returns its pivot.
-    fn reduce(&mut self, e: Edge, p0: Option<Tri>, heap: &mut BinaryHeap<Tri>) -> Option<Tri> {
+    fn reduce(&mut self, e: Edge, p0: Option<Tri>, heap: &mut Column) -> Option<Tri> {
         let p0 = p0?;
         if self.owner(&p0).is_none() {
             // Emergent pair: the unreduced column already has a fresh pivot.
@@ -304,22 +316,47 @@ impl<M: Metric> Reducer<'_, M> {
             self.columns.push(vec![e]);
             return Some(p0);
         }
+        // Truncated reduction: the heap holds the working column restricted to values
+        // ≤ `bound`, so while it is non-empty its top is the true pivot. When it empties,
+        // the bound is raised and the missing cofacets of the reduction-matrix column are
+        // pushed. Most deaths are close to their births, so most columns never generate
+        // (or heap) the ~n cofacets of every added column; long bars pay once per raise
+        // for a scan without pushes.
+        let mut bound = if p0.value() > 0.0 {
+            (2.0 * p0.value()).min(self.t)
+        } else {
+            self.t
+        };
         heap.clear();
-        self.push_coboundary(heap, &e);
+        self.push_coboundary(heap, &e, f64::NEG_INFINITY, bound);
         let mut v = vec![e];
+        let mut compact_at = COMPACT_MIN;
         loop {
-            let Some(p) = pop_pivot(heap) else {
-                return None;
+            if heap.len() > compact_at {
+                heap.compact();
+                compact_at = COMPACT_MIN.max(2 * heap.len());
+            }
+            let Some(p) = heap.pivot() else {
+                if bound >= self.t {
+                    return None;
+                }
+                let lo = bound;
+                bound = (2.0 * bound).min(self.t);
+                canonical(&mut v);
+                for f in &v {
+                    self.push_coboundary(heap, f, lo, bound);
+                }
+                continue;
             };
             match self.owner(&p) {
                 Some(Owner::Apparent(f)) => {
-                    self.push_coboundary(heap, &f);
+                    self.push_coboundary(heap, &f, f64::NEG_INFINITY, bound);
                     v.push(f);
                 }
                 Some(Owner::Reduced(j)) => {
                     let col = std::mem::take(&mut self.columns[j]);
                     for f in &col {
-                        self.push_coboundary(heap, f);
+                        self.push_coboundary(heap, f, f64::NEG_INFINITY, bound);
                     }
                     v.extend_from_slice(&col);
                     self.columns[j] = col;
@@ -335,22 +372,25 @@ impl<M: Metric> Reducer<'_, M> {
     }
 }
 
+/// Heap size (entries) below which a working column is never compacted.
+const COMPACT_MIN: usize = 1 << 16;
+
 /// Sorts a Z/2 chain and cancels repeated entries in pairs.
 pub(crate) fn canonical<T: Ord + Copy>(v: &mut Vec<T>) {
     v.sort_unstable();
-    let mut out = Vec::with_capacity(v.len());
-    let mut i = 0;
+    let (mut w, mut i) = (0, 0);
     while i < v.len() {
         let mut j = i;
         while j < v.len() && v[j] == v[i] {
             j += 1;
         }
         if (j - i) % 2 == 1 {
-            out.push(v[i]);
+            v[w] = v[i];
+            w += 1;
         }
         i = j;
     }
-    *v = out;
+    v.truncate(w);
 }
 
 /// Pops the top of a Z/2 heap column, cancelling equal entries in pairs, and leaves the
@@ -422,7 +462,7 @@ pub(crate) fn compute<M: Metric>(m: &M, t: f64, h1: bool) -> Raw {
         })
         .collect();
     // Reverse filtration order: youngest edge first.
-    todo.sort_unstable_by(|x, y| y.0.cmp(&x.0));
+    todo.sort_unstable_by_key(|x| std::cmp::Reverse(x.0));
     let mut red = Reducer {
         m,
         t,
@@ -430,7 +470,7 @@ pub(crate) fn compute<M: Metric>(m: &M, t: f64, h1: bool) -> Raw {
         pivots: HashMap::new(),
         columns: Vec::new(),
     };
-    let mut heap = BinaryHeap::new();
+    let mut heap = Column::new();
     let mut pairs = Vec::new();
     let mut reduced = HashMap::new();
     for (e, p0) in todo {

@@ -6,8 +6,8 @@
 //! Vietoris–Rips persistence barcodes", J. Appl. Comput. Topol. 5, 2021): persistent
 //! *cohomology* with clearing, an implicit coboundary over simplices named by the
 //! combinatorial number system, apparent and emergent pairs, the enclosing radius as the
-//! default threshold and union–find-equivalent spanning trees for H0. See [`engine`] for
-//! the stages and their cost and [`cycles`] for the representative cycles of H1 bars.
+//! default threshold and union–find-equivalent spanning trees for H0. `engine.rs` documents
+//! the stages and their cost, `cycles.rs` the representative cycles of H1 bars.
 //!
 //! In short, for `n` points: `O(n²)` time for H0, and for H1 `O(n²)` vertex probes on
 //! generic inputs plus the reduction of the few edges not in an apparent pair; memory
@@ -26,9 +26,10 @@
 //! assert_eq!(d.betti_at(0, 0.5), 4);
 //! ```
 
-pub mod cycles;
+mod column;
+mod cycles;
 mod diagram;
-pub mod engine;
+mod engine;
 mod metric;
 mod params;
 
