@@ -39,6 +39,10 @@ pub struct LocalParams {
     pub min_share: f64,
     /// The robust-feature classifier (default: the shipped model).
     pub classifier: Classifier,
+    /// Draw the representatives only from encounters with an agent that was a static
+    /// landmark at the time (their position is that of the landmark, known exactly up to
+    /// r_d), instead of from all encounters (default: `false`, the paper's choice).
+    pub anchored: bool,
 }
 
 impl Default for LocalParams {
@@ -49,6 +53,7 @@ impl Default for LocalParams {
             min_component: 20,
             min_share: 0.02,
             classifier: Classifier::default(),
+            anchored: false,
         }
     }
 }
@@ -144,6 +149,17 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         .cloned()
         .collect();
     let graph = EncounterGraph::build(&enc, &statics, p.bridging);
+    let anchored: Vec<bool> = enc
+        .iter()
+        .map(|e| {
+            statics.iter().any(|s| {
+                s.reason == crate::log::StaticReason::Landmark
+                    && (s.agent == e.a || s.agent == e.b)
+                    && s.start <= e.end
+                    && e.start <= s.end
+            })
+        })
+        .collect();
     let labels = graph.components();
     let n = enc.len();
     let mut groups: Vec<Vec<usize>> = Vec::new();
@@ -162,7 +178,15 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
     let mut rows_out = Vec::new();
     let mut explained = Vec::new();
     for members in groups.into_iter().filter(|g| g.len() >= min_size.max(3)) {
-        let sub = subsample(&graph, &members, &p.subsample);
+        let candidates: Vec<usize> = if p.anchored {
+            members.iter().copied().filter(|&j| anchored[j]).collect()
+        } else {
+            members.clone()
+        };
+        if candidates.len() < 3 {
+            continue;
+        }
+        let sub = subsample(&graph, &candidates, &p.subsample);
         let m = sub.picks.len();
         let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
         let opts = RipsOptions {

@@ -73,7 +73,7 @@ pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
     for (p, row) in &map.rows {
         for (j, &d) in row.iter().enumerate() {
             k += 1;
-            if k % stride != 0 || !d.is_finite() || j == *p {
+            if !k.is_multiple_of(stride) || !d.is_finite() || j == *p {
                 continue;
             }
             let (a, b) = (truth[*p], truth[j]);
