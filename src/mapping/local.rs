@@ -43,6 +43,9 @@ pub struct LocalParams {
     /// landmark at the time (their position is that of the landmark, known exactly up to
     /// r_d), instead of from all encounters (default: `false`, the paper's choice).
     pub anchored: bool,
+    /// Build the lazy witness complex of the representatives with this ν (witnesses: all
+    /// encounters of the component) instead of the Vietoris–Rips complex (default: `None`).
+    pub witness: Option<usize>,
 }
 
 impl Default for LocalParams {
@@ -54,6 +57,7 @@ impl Default for LocalParams {
             min_share: 0.02,
             classifier: Classifier::default(),
             anchored: false,
+            witness: None,
         }
     }
 }
@@ -188,7 +192,10 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         }
         let sub = subsample(&graph, &candidates, &p.subsample);
         let m = sub.picks.len();
-        let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
+        let metric = match p.witness {
+            None => DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]),
+            Some(nu) => super::witness::lazy_witness(&sub.rows, &members, nu),
+        };
         let opts = RipsOptions {
             maxdim: 1,
             threshold: None,

@@ -9,3 +9,4 @@ pub mod stitch;
 pub mod subsample;
 pub mod synthetic;
 pub mod windows;
+pub mod witness;
