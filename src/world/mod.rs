@@ -1,7 +1,7 @@
 //! Worlds: the arena, its obstacles and every parameter of a run (paper §"Problem
 //! Statement", §"Simulation Results").
 //!
-//! A world file is RON (format in `docs/world-format.md`). Reading is two-step, as in
+//! A world file is RON (format in the README, "World files"). Reading is two-step, as in
 //! linfa's checked parameters: [`parse_str`] turns the text into a raw [`WorldSpec`]
 //! (every field optional, unknown fields rejected with the list of valid ones, syntax
 //! errors at `file:line:col`); [`apply_override`] may then set fields by dotted path; and

@@ -54,7 +54,7 @@ pub enum PlacementSpec {
     Window,
 }
 
-/// `swarm: (...)`; see `docs/world-format.md` for units and defaults.
+/// `swarm: (...)`; see the README, "World files", for units and defaults.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SwarmSpec {
@@ -200,7 +200,7 @@ fn explain(code: &ron::Error) -> String {
         }
         E::Eof => "unexpected end of the file; a closing bracket is probably missing".into(),
         E::ExpectedComma => "expected a comma here, between the previous entry and this one".into(),
-        other => format!("{other} (see docs/world-format.md for the format)"),
+        other => format!("{other} (see the README's World files section for the format)"),
     }
 }
 
