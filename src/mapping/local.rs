@@ -21,9 +21,9 @@ use super::encounter_graph::{Bridging, EncounterGraph};
 use super::subsample::{SubsampleParams, subsample};
 use super::windows::Window;
 use crate::log::{Encounter, EncounterLog};
-use crate::topology::DistanceMatrix;
 use crate::topology::mds::landmark_mds;
-use crate::topology::rips::{RipsOptions, rips_matrix};
+use crate::topology::rips::{RipsOptions, rips_matrix, rips_points};
+use crate::topology::{DistanceMatrix, PointCloud};
 use serde::Serialize;
 
 /// Parameters of local mapping.
@@ -46,6 +46,9 @@ pub struct LocalParams {
     /// Build the lazy witness complex of the representatives with this ν (witnesses: all
     /// encounters of the component) instead of the Vietoris–Rips complex (default: `None`).
     pub witness: Option<usize>,
+    /// Compute persistence on the encounter point cloud (the MDS embedding) after a
+    /// density filter, instead of on the metric (default: `None`).
+    pub embedding_rips: Option<super::dense::DenseParams>,
 }
 
 impl Default for LocalParams {
@@ -58,6 +61,7 @@ impl Default for LocalParams {
             classifier: Classifier::default(),
             anchored: false,
             witness: None,
+            embedding_rips: None,
         }
     }
 }
@@ -191,59 +195,6 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
             continue;
         }
         let sub = subsample(&graph, &candidates, &p.subsample);
-        let m = sub.picks.len();
-        let metric = match p.witness {
-            None => DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]),
-            Some(nu) => super::witness::lazy_witness(&sub.rows, &members, nu),
-        };
-        let opts = RipsOptions {
-            maxdim: 1,
-            threshold: None,
-            cycles: true,
-            threads: 0,
-        };
-        let diagram = rips_matrix(&metric, &opts);
-        let features: Vec<Feature> = diagram
-            .bars
-            .iter()
-            .map(|b| Feature {
-                dim: b.dim,
-                birth: b.birth,
-                death: b.death,
-            })
-            .collect();
-        let sigma = sampling_scale(&features);
-        let mut betti = [0, 0];
-        let mut bars = Vec::new();
-        let mut holes = Vec::new();
-        for (bar, f) in diagram.bars.iter().zip(&features) {
-            let robust = p.classifier.robust(f, sigma);
-            if robust && f.dim < 2 {
-                betti[f.dim] += 1;
-            }
-            if robust && f.dim == 1 {
-                let cycle = bar
-                    .cycle
-                    .as_ref()
-                    .map(|c| {
-                        c.iter()
-                            .map(|&(x, y)| (sub.picks[x], sub.picks[y]))
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                holes.push(Hole {
-                    birth: f.birth,
-                    death: f.death,
-                    cycle,
-                });
-            }
-            bars.push(MapBar {
-                dim: f.dim,
-                birth: f.birth,
-                death: f.death.is_finite().then_some(f.death),
-                robust,
-            });
-        }
         // Embed every member of the component from the representatives' rows.
         let rows: Vec<Vec<f64>> = sub
             .rows
@@ -266,13 +217,80 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 ];
             }
         }
+        let opts = RipsOptions {
+            maxdim: 1,
+            threshold: None,
+            cycles: true,
+            threads: 0,
+        };
+        let (diagram, reps) = match (&p.embedding_rips, p.witness) {
+            (Some(er), _) => {
+                let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
+                let picks = super::dense::dense_maxmin(&coords, er);
+                let cloud = PointCloud::from_rows(
+                    &picks
+                        .iter()
+                        .map(|&k| coords[k][..er.dims.clamp(2, 3)].to_vec())
+                        .collect::<Vec<_>>(),
+                )
+                .expect("finite embedding");
+                let reps: Vec<usize> = picks.iter().map(|&k| members[k]).collect();
+                (rips_points(&cloud, &opts), reps)
+            }
+            (None, Some(nu)) => {
+                let metric = super::witness::lazy_witness(&sub.rows, &members, nu);
+                (rips_matrix(&metric, &opts), sub.picks.clone())
+            }
+            (None, None) => {
+                let m = sub.picks.len();
+                let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
+                (rips_matrix(&metric, &opts), sub.picks.clone())
+            }
+        };
+        let features: Vec<Feature> = diagram
+            .bars
+            .iter()
+            .map(|b| Feature {
+                dim: b.dim,
+                birth: b.birth,
+                death: b.death,
+            })
+            .collect();
+        let sigma = sampling_scale(&features);
+        let mut betti = [0, 0];
+        let mut bars = Vec::new();
+        let mut holes = Vec::new();
+        for (bar, f) in diagram.bars.iter().zip(&features) {
+            let robust = p.classifier.robust(f, sigma);
+            if robust && f.dim < 2 {
+                betti[f.dim] += 1;
+            }
+            if robust && f.dim == 1 {
+                let cycle = bar
+                    .cycle
+                    .as_ref()
+                    .map(|c| c.iter().map(|&(x, y)| (reps[x], reps[y])).collect())
+                    .unwrap_or_default();
+                holes.push(Hole {
+                    birth: f.birth,
+                    death: f.death,
+                    cycle,
+                });
+            }
+            bars.push(MapBar {
+                dim: f.dim,
+                birth: f.birth,
+                death: f.death.is_finite().then_some(f.death),
+                robust,
+            });
+        }
         for &j in &members {
             noise[j] = false;
         }
         rows_out.extend(sub.picks.iter().copied().zip(sub.rows));
         components.push(Component {
             events: members,
-            representatives: sub.picks,
+            representatives: reps,
             scale: sigma,
             diagram: bars,
             betti,

@@ -1,6 +1,7 @@
 //! Local and global mapping from encounter logs (paper §"Dynamic Topological Mapping").
 
 pub mod classify;
+pub mod dense;
 pub mod encounter_graph;
 pub mod local;
 pub mod output;

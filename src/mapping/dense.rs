@@ -1,0 +1,197 @@
+//! Density-filtered farthest-point subsampling of an embedded point cloud (after the
+//! "density based subsampling" of Dirafzoon et al. 2014, which the paper uses).
+//!
+//! Encounters whose embedding is wrong by more than the sampling scale scatter into the
+//! regions where no encounter can happen (obstacles) and fill the holes. They are rare
+//! there, so their local density is low: we estimate density by the distance to the k-th
+//! nearest neighbour, keep the densest `keep` share of the points, and pick m of those by
+//! farthest-point selection so the subsample covers the dense set evenly.
+//! Cost: O(n log n) grid k-NN in the embedding for typical clouds, O(m · n) selection.
+
+use std::collections::HashMap;
+
+/// Parameters of the dense subsample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DenseParams {
+    /// Coordinates used (2: the plane of the first two MDS axes, or 3) (default: `2`).
+    pub dims: usize,
+    /// Neighbour rank of the density estimate (default: `10`).
+    pub k: usize,
+    /// Share of the densest points kept (default: `0.8`).
+    pub keep: f64,
+    /// Number of representatives m (default: `400`).
+    pub m: usize,
+}
+
+impl Default for DenseParams {
+    fn default() -> Self {
+        Self {
+            dims: 2,
+            k: 10,
+            keep: 0.8,
+            m: 400,
+        }
+    }
+}
+
+fn dist(a: &[f64; 3], b: &[f64; 3], dims: usize) -> f64 {
+    (0..dims)
+        .map(|i| (a[i] - b[i]) * (a[i] - b[i]))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The k-th nearest-neighbour distance of every point, via a uniform grid on the first
+/// two coordinates.
+pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
+    let n = points.len();
+    if n <= 1 {
+        return vec![0.0; n];
+    }
+    let k = k.clamp(1, n - 1);
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for i in 0..2 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
+    // Cells holding about k points each.
+    let cell = (area * k as f64 / n as f64).sqrt().max(1e-12);
+    let key = |p: &[f64; 3]| {
+        (
+            ((p[0] - lo[0]) / cell).floor() as i64,
+            ((p[1] - lo[1]) / cell).floor() as i64,
+        )
+    };
+    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, p) in points.iter().enumerate() {
+        grid.entry(key(p)).or_default().push(i);
+    }
+    let mut d = Vec::new();
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (cx, cy) = key(p);
+            let mut ring = 1i64;
+            loop {
+                d.clear();
+                for x in cx - ring..=cx + ring {
+                    for y in cy - ring..=cy + ring {
+                        if let Some(v) = grid.get(&(x, y)) {
+                            d.extend(
+                                v.iter()
+                                    .filter(|&&j| j != i)
+                                    .map(|&j| dist(p, &points[j], dims)),
+                            );
+                        }
+                    }
+                }
+                // The k-th distance is exact once it is within the searched ring.
+                if d.len() >= k {
+                    d.select_nth_unstable_by(k - 1, f64::total_cmp);
+                    if d[k - 1] <= ring as f64 * cell || d.len() >= n - 1 {
+                        return d[k - 1];
+                    }
+                } else if d.len() >= n - 1 {
+                    return d.iter().copied().fold(0.0, f64::max);
+                }
+                ring *= 2;
+            }
+        })
+        .collect()
+}
+
+/// Indices (into `points`) of the dense subsample, in farthest-point order.
+pub fn dense_maxmin(points: &[[f64; 3]], p: &DenseParams) -> Vec<usize> {
+    let dims = p.dims.clamp(2, 3);
+    let r = knn_radius(points, p.k, dims);
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| r[a].total_cmp(&r[b]).then(a.cmp(&b)));
+    let kept =
+        ((points.len() as f64 * p.keep).ceil() as usize).clamp(1.min(points.len()), points.len());
+    let mut kept: Vec<usize> = order[..kept].to_vec();
+    kept.sort_unstable();
+    if kept.is_empty() {
+        return kept;
+    }
+    let mut picks = vec![kept[0]];
+    let mut nearest: Vec<f64> = kept
+        .iter()
+        .map(|&j| dist(&points[j], &points[kept[0]], dims))
+        .collect();
+    while picks.len() < p.m.min(kept.len()) {
+        let (k, d) = nearest
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |b, (k, &d)| if d > b.1 { (k, d) } else { b },
+            );
+        if d <= 0.0 {
+            break;
+        }
+        let j = kept[k];
+        picks.push(j);
+        for (t, &i) in kept.iter().enumerate() {
+            nearest[t] = nearest[t].min(dist(&points[i], &points[j], dims));
+        }
+    }
+    picks
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knn_matches_brute_force() {
+        let pts: Vec<[f64; 3]> = (0..300)
+            .map(|i| {
+                let t = i as f64;
+                [
+                    (t * 0.37).sin() * 5.0 + t * 0.01,
+                    (t * 0.73).cos() * 3.0,
+                    0.0,
+                ]
+            })
+            .collect();
+        let r = knn_radius(&pts, 5, 2);
+        for (i, p) in pts.iter().enumerate() {
+            let mut d: Vec<f64> = pts
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| dist(p, q, 2))
+                .collect();
+            d.sort_by(f64::total_cmp);
+            assert!(
+                (r[i] - d[4]).abs() < 1e-12,
+                "point {i}: {} vs {}",
+                r[i],
+                d[4]
+            );
+        }
+    }
+
+    #[test]
+    fn sparse_points_are_dropped() {
+        // A dense grid and one far-away point: the lone point is not kept.
+        let mut pts: Vec<[f64; 3]> = (0..400)
+            .map(|i| [(i % 20) as f64, (i / 20) as f64, 0.0])
+            .collect();
+        pts.push([100.0, 100.0, 0.0]);
+        let picks = dense_maxmin(
+            &pts,
+            &DenseParams {
+                keep: 0.9,
+                m: 50,
+                ..Default::default()
+            },
+        );
+        assert_eq!(picks.len(), 50);
+        assert!(!picks.contains(&400));
+    }
+}
