@@ -1,6 +1,7 @@
 //! Subcommands. Each lives in its own file and returns `Result<(), Failure>`; the exit
 //! code comes from the failure's kind, never from a panic.
 
+mod calibrate;
 mod check;
 mod eval;
 mod map;
@@ -80,6 +81,8 @@ enum Command {
     Run(run::RunArgs),
     /// Accuracy over many worlds, seeds and parameter values, in parallel.
     Eval(eval::EvalArgs),
+    /// Fit the robust-feature classifier on training worlds.
+    Calibrate(calibrate::CalibrateArgs),
     /// Vietoris–Rips persistence diagram (H0, H1) of a CSV of points or distances.
     Persistence(persistence::PersistenceArgs),
 }
@@ -92,6 +95,7 @@ pub fn main() -> ExitCode {
         Command::Map(args) => map::run(&args),
         Command::Run(args) => run::run(&args),
         Command::Eval(args) => eval::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
         Command::Persistence(a) => persistence::run(a),
     };
     match result {

@@ -32,11 +32,56 @@ pub struct Classifier {
     pub h1_span: f64,
 }
 
+/// The shipped models, one per mapping method (`assets/classifier.json`), with a note on
+/// what each was fitted on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Models {
+    #[serde(rename = "Paper")]
+    pub paper: Model,
+    #[serde(rename = "Embedded")]
+    pub embedded: Model,
+}
+
+/// A fitted classifier and its provenance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Model {
+    pub classifier: Classifier,
+    /// How it was fitted (command, worlds, seeds) and its training accuracy.
+    pub fitted_on: String,
+}
+
+/// The text of the shipped models.
+pub const SHIPPED: &str = include_str!("../../assets/classifier.json");
+
+impl Models {
+    /// The shipped models.
+    pub fn shipped() -> Self {
+        serde_json::from_str(SHIPPED).expect("assets/classifier.json is a valid model file")
+    }
+
+    /// The model of a method.
+    pub fn get(&self, method: crate::world::MappingMethod) -> &Model {
+        match method {
+            crate::world::MappingMethod::Paper => &self.paper,
+            crate::world::MappingMethod::Embedded => &self.embedded,
+        }
+    }
+
+    /// Mutable access to the model of a method.
+    pub fn get_mut(&mut self, method: crate::world::MappingMethod) -> &mut Model {
+        match method {
+            crate::world::MappingMethod::Paper => &mut self.paper,
+            crate::world::MappingMethod::Embedded => &mut self.embedded,
+        }
+    }
+}
+
 impl Default for Classifier {
-    /// The shipped model (`assets/classifier.json`).
+    /// The shipped model of the paper's method.
     fn default() -> Self {
-        serde_json::from_str(include_str!("../../assets/classifier.json"))
-            .expect("assets/classifier.json is a valid classifier")
+        Models::shipped().paper.classifier
     }
 }
 
@@ -125,7 +170,9 @@ mod tests {
 
     #[test]
     fn shipped_model_loads() {
-        let c = Classifier::default();
-        assert!(c.h0_ratio > 0.0 && c.h1_ratio >= 1.0 && c.h1_span > 0.0);
+        let m = Models::shipped();
+        for c in [m.paper.classifier, m.embedded.classifier] {
+            assert!(c.h0_ratio > 0.0 && c.h1_ratio >= 1.0 && c.h1_span >= 0.0);
+        }
     }
 }

@@ -71,9 +71,15 @@ impl LocalParams {
     pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
-        p.bridging = match m.method {
-            crate::world::MappingMethod::Paper => Bridging::Paper,
-        };
+        p.classifier = super::classify::Models::shipped().get(m.method).classifier;
+        p.bridging = Bridging::Paper;
+        if m.method == crate::world::MappingMethod::Embedded {
+            p.anchored = true;
+            p.embedding_rips = Some(super::dense::DenseParams {
+                m: m.subsample.min(300),
+                ..Default::default()
+            });
+        }
         p
     }
 }

@@ -580,6 +580,7 @@ impl WorldSpec {
         )?;
         let method = match m.method {
             None | Some(MethodSpec::Paper) => MappingMethod::Paper,
+            Some(MethodSpec::Embedded) => MappingMethod::Embedded,
         };
         let mapping = MappingParams {
             windows,

@@ -88,10 +88,12 @@ pub struct SimulationSpec {
     pub dispersion_time: Option<f64>,
 }
 
-/// `method: Paper`. Mirrors [`super::MappingMethod`]; a new method needs a variant here.
+/// `method: Paper` or `method: Embedded`. Mirrors [`super::MappingMethod`]; a new method
+/// needs a variant here.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum MethodSpec {
     Paper,
+    Embedded,
 }
 
 /// `mapping: (...)`.

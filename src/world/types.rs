@@ -119,8 +119,12 @@ impl Default for SimulationParams {
 /// Which local-mapping method to run (issue #4 adds improved methods).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MappingMethod {
-    /// The paper's method exactly (§"Geometric Reconstruction").
+    /// The paper's method exactly (§"Geometric Reconstruction"): Rips on the encounter
+    /// metric of m MaxMin representatives.
     Paper,
+    /// Representatives anchored at static landmarks, the encounter point cloud embedded by
+    /// landmark MDS, and Rips on its density-filtered plane (see `mapping::local`).
+    Embedded,
 }
 
 /// Parameters of the mapping stages (paper §"Dynamic Topological Mapping").

@@ -1,0 +1,146 @@
+//! `swarmmap calibrate [WORLD...] [--seeds 1..5] [--set PATH=VALUE]... [--out FILE]`: fit the
+//! robust-feature classifier on training worlds and write the model file.
+
+use super::{Failure, input, load_world};
+use anyhow::{Context, anyhow};
+use clap::Args;
+use rayon::prelude::*;
+use std::path::PathBuf;
+use swarmmap::eval::calibrate::{Sample, fit};
+use swarmmap::eval::truth::{FreeSpace, window_band};
+use swarmmap::io::write_atomic;
+use swarmmap::mapping::classify::Models;
+use swarmmap::mapping::pipeline::{MapConfig, map_windows};
+use swarmmap::sim::{SimOptions, simulate};
+use swarmmap::world::{MappingMethod, World};
+
+/// Options of `swarmmap calibrate`.
+#[derive(Args, Debug)]
+pub struct CalibrateArgs {
+    /// Training worlds (default: every `worlds/training/*.ron`). Never the evaluation
+    /// scenarios: a classifier fitted on them would be judged on its own training data.
+    pub worlds: Vec<PathBuf>,
+    /// Seeds: `A..B` (inclusive) or a comma-separated list.
+    #[arg(long, default_value = "1..5")]
+    pub seeds: String,
+    /// Override a field of every training world, e.g. `--set mapping.method=Embedded`.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Runs in parallel (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Model file to update: the fitted method's entry is replaced, the others kept
+    /// (default: `assets/classifier.json`, the model compiled into swarmmap).
+    #[arg(long, default_value = "assets/classifier.json")]
+    pub out: PathBuf,
+}
+
+pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
+    let seeds = super::eval::parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
+    let mut paths = args.worlds.clone();
+    if paths.is_empty() {
+        let dir = PathBuf::from("worlds/training");
+        let entries = std::fs::read_dir(&dir)
+            .with_context(|| format!("listing {}", dir.display()))
+            .map_err(input)?;
+        paths = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+            .collect();
+        paths.sort();
+    }
+    if paths.is_empty() {
+        return Err(input(anyhow!(
+            "no training worlds: give world files or add worlds/training/*.ron"
+        )));
+    }
+    let worlds: Vec<World> = paths
+        .iter()
+        .map(|p| load_world(p, &args.set))
+        .collect::<Result<_, _>>()?;
+    let jobs: Vec<(&World, u64)> = worlds
+        .iter()
+        .flat_map(|w| seeds.iter().map(move |&s| (w, s)))
+        .collect();
+    let threads = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| Failure::Other(e.into()))?;
+    let results: Vec<Result<(MappingMethod, Vec<Sample>), String>> = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(world, seed)| {
+                let out = simulate(world, &SimOptions::new(seed))
+                    .map_err(|e| format!("{} seed {seed}: {e}", world.name))?;
+                let cfg = MapConfig::for_world(world);
+                let fs = FreeSpace::for_world(world).map_err(|e| e.to_string())?;
+                let samples = cfg
+                    .windows()
+                    .iter()
+                    .zip(map_windows(&out.log, &cfg))
+                    .map(|(w, m)| {
+                        let (a, b) = window_band(world, w.start, w.end);
+                        Sample::from_map(&m, fs.betti_in_band(a, b))
+                    })
+                    .collect();
+                eprintln!("calibrate: {} seed {seed} done", world.name);
+                Ok((world.mapping.method, samples))
+            })
+            .collect()
+    });
+    let mut models: Models = match std::fs::read_to_string(&args.out) {
+        Ok(text) => serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a model file", args.out.display()))
+            .map_err(input)?,
+        Err(_) => Models::shipped(),
+    };
+    let mut by_method: Vec<(MappingMethod, Vec<Sample>)> = Vec::new();
+    for r in results {
+        let (method, samples) = r.map_err(|e| Failure::Other(anyhow!(e)))?;
+        match by_method.iter_mut().find(|(m, _)| *m == method) {
+            Some((_, v)) => v.extend(samples),
+            None => by_method.push((method, samples)),
+        }
+    }
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    for (method, samples) in &by_method {
+        let f = fit(samples).ok_or_else(|| Failure::Other(anyhow!("no training windows")))?;
+        println!(
+            "{method:?}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
+             both right {:.1} %, β0 {:.1} %, β1 {:.1} %",
+            f.classifier.h0_ratio,
+            f.classifier.h1_ratio,
+            f.classifier.h1_span,
+            f.windows,
+            100.0 * f.accuracy,
+            100.0 * f.b0_accuracy,
+            100.0 * f.b1_accuracy
+        );
+        let m = models.get_mut(*method);
+        m.classifier = f.classifier;
+        m.fitted_on = format!(
+            "swarmmap calibrate --seeds {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %)",
+            args.seeds,
+            args.set
+                .iter()
+                .map(|s| format!("--set {s} "))
+                .collect::<String>(),
+            names.join(" "),
+            f.windows,
+            100.0 * f.accuracy,
+            100.0 * f.b0_accuracy,
+            100.0 * f.b1_accuracy
+        );
+    }
+    let mut text = serde_json::to_string_pretty(&models).map_err(|e| Failure::Other(e.into()))?;
+    text.push('\n');
+    write_atomic(&args.out, text.as_bytes())
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    println!(
+        "model written to {} (rebuild swarmmap to use it as the default)",
+        args.out.display()
+    );
+    Ok(())
+}
