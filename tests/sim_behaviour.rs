@@ -188,7 +188,10 @@ fn landmark_fraction_holds_inside_the_leaders_domain() {
     w.obstacles.truncate(2);
     w.leader.speed = 0.005;
     w.leader.end_x = 4.5;
-    let every = 0.5;
+    // Return episodes last a few seconds at most (the domain's edge moves 5 mm/s), so the
+    // closing speed below is measured over 0.1 s samples: at 0.5 s a run had only 1 to 10
+    // sample pairs in `return`, too few to measure anything.
+    let every = 0.1;
     let out = run(&w, 11, every);
     let traj = out.trajectories.as_ref().expect("trajectories");
     let disp = w.simulation.dispersion_time;

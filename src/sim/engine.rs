@@ -333,10 +333,10 @@ impl Run<'_> {
 
     /// Holds round(fraction × agents inside D(t)) landmarks among the agents inside D(t).
     fn upkeep_landmarks(&mut self, pos: &[P], t: f64, domain: P, leader_x: f64) {
-        let inside: Vec<usize> = (0..pos.len())
-            .filter(|&i| pos[i].0 >= domain.0 && pos[i].0 <= domain.1)
-            .collect();
-        let target = (self.world.swarm.landmark_fraction * inside.len() as f64).round() as usize;
+        let is_inside = |p: &P| p.0 >= domain.0 && p.0 <= domain.1;
+        // Counted without allocating: the candidates are only listed when a pick is due.
+        let n_inside = pos.iter().filter(|p| is_inside(p)).count();
+        let target = (self.world.swarm.landmark_fraction * n_inside as f64).round() as usize;
         while self.landmarks.len() > target {
             // Release the newest: the older landmarks keep their MaxMin spread.
             let Some(i) = self.landmarks.pop() else { break };
@@ -345,6 +345,7 @@ impl Run<'_> {
             self.resume(i, pos[i], leader_x);
         }
         if self.landmarks.len() < target {
+            let inside: Vec<usize> = (0..pos.len()).filter(|&i| is_inside(&pos[i])).collect();
             let cand: Vec<P> = inside.iter().map(|&i| pos[i]).collect();
             let flags: Vec<bool> = inside
                 .iter()
@@ -427,13 +428,37 @@ impl Run<'_> {
 
     /// Finds the near pairs whose bodies have just come to touch at `pos` and gives each
     /// moving agent involved the outward normal of the contact, from the exact geometry.
+    /// Normals are only computed for a new touch: the gap alone decides the rest.
     fn detect_touches(&mut self, pos: &[P]) {
         let world = self.world;
         let r = world.swarm.body_radius;
         for &(a, other) in &self.near {
             let pa = pos[a as usize];
-            let mut normals: [Option<(usize, P)>; 4] = [None; 4];
             let gap = match other {
+                Other::Agent(b) => {
+                    let pb = pos[b as usize];
+                    (pa.0 - pb.0).hypot(pa.1 - pb.1) - 2.0 * r
+                }
+                Other::Obstacle(k) => {
+                    let Some(o) = world.obstacles.get(k as usize) else {
+                        continue;
+                    };
+                    o.signed_distance(pa) - r
+                }
+                Other::Sides => side_gaps(world, pa, r)
+                    .iter()
+                    .map(|s| s.0)
+                    .fold(f64::INFINITY, f64::min),
+            };
+            if gap > TOUCH_GAP {
+                self.touching.remove(&(a, other));
+                continue;
+            }
+            if !self.touching.insert((a, other)) {
+                continue;
+            }
+            let mut normals: [Option<(usize, P)>; 4] = [None; 4];
+            match other {
                 Other::Agent(b) => {
                     let pb = pos[b as usize];
                     let d = (pa.0 - pb.0, pa.1 - pb.1);
@@ -443,14 +468,12 @@ impl Run<'_> {
                         normals[0] = Some((a as usize, n));
                         normals[1] = Some((b as usize, (-n.0, -n.1)));
                     }
-                    len - 2.0 * r
                 }
                 Other::Obstacle(k) => {
-                    let Some(o) = world.obstacles.get(k as usize) else {
-                        continue;
-                    };
-                    normals[0] = gradient(|q| o.signed_distance(q), pa).map(|n| (a as usize, n));
-                    o.signed_distance(pa) - r
+                    if let Some(o) = world.obstacles.get(k as usize) {
+                        normals[0] =
+                            gradient(|q| o.signed_distance(q), pa).map(|n| (a as usize, n));
+                    }
                 }
                 Other::Sides => {
                     let sides = side_gaps(world, pa, r);
@@ -459,16 +482,11 @@ impl Run<'_> {
                             *slot = Some((a as usize, n));
                         }
                     }
-                    sides.iter().map(|s| s.0).fold(f64::INFINITY, f64::min)
                 }
-            };
-            if gap > TOUCH_GAP {
-                self.touching.remove(&(a, other));
-            } else if self.touching.insert((a, other)) {
-                for (i, n) in normals.into_iter().flatten() {
-                    if self.agents[i].moving() {
-                        self.agents[i].normals.push(n);
-                    }
+            }
+            for (i, n) in normals.into_iter().flatten() {
+                if self.agents[i].moving() {
+                    self.agents[i].normals.push(n);
                 }
             }
         }

@@ -38,12 +38,20 @@ const SIDE_THICKNESS: f32 = 1.0;
 /// millimetres, so every tolerance is set explicitly in metres below. The one tolerance
 /// that cannot be set on its own is the broad phase's fat-AABB skin, `0.04 × length_unit`:
 /// a leaf of the BVH is only updated once its collider has moved by more than the skin.
-/// Agents move 2 mm per step, so the default 0.4 mm skin (at a 1 cm unit) would update every
-/// leaf at every step; a 1 cm skin updates a leaf every five steps. Larger skins cost more
-/// than they save in dense swarms (more candidate pairs); see `docs/simulation.md`.
 const SKIN_FACTOR: f32 = 0.04;
-/// Broad-phase skin, metres.
-const BROAD_PHASE_SKIN: f32 = 0.01;
+/// Broad-phase skin of dense swarms, metres. Rapier's BVH has two regimes: when at least
+/// 1/16 of the leaves leave their fat AABB in a step, it updates them in place and runs
+/// its incremental optimiser and a full refit every step; below that it relocates each
+/// moved leaf by SAH re-insertion and refits only their ancestors. Dense swarms are
+/// always in the first regime, where a small skin is best (fewer candidate pairs);
+/// 0.5–1 cm measured equal, 1.5 cm and more slower (`docs/simulation.md`).
+const DENSE_SKIN: f64 = 0.01;
+/// Sparse skin, in steps of travel at `speed`: fewer than 1/16 of the moving leaves
+/// (1/25.6) leave their fat AABB per step, so the BVH stays in the re-insertion regime.
+const SPARSE_SKIN_STEPS: f64 = 25.6;
+/// Largest expected number of other colliders overlapping a leaf's fat AABB for which the
+/// sparse skin pays; measured crossover between 6.7 and 13 agents/m² at the defaults.
+const SPARSE_MAX_NEIGHBOURS: f64 = 0.3;
 /// Rapier's contacts are speculative: a pair gets a contact constraint once its gap is
 /// below the prediction distance, and the solver then stops the bodies exactly at contact.
 /// The distance must exceed what two agents close in one step (2 v dt), or they overlap
@@ -208,18 +216,17 @@ impl Scene {
     /// Builds the scene with one agent at each of `positions`.
     pub(crate) fn new(world: &World, positions: &[(f64, f64)], dt: f64) -> Self {
         let prediction = Self::prediction_distance(world, dt) as f32;
+        let skin = Self::broad_phase_skin(world, dt) as f32;
         let params = IntegrationParameters {
             dt: dt as f32,
-            length_unit: BROAD_PHASE_SKIN / SKIN_FACTOR,
-            normalized_prediction_distance: prediction * SKIN_FACTOR / BROAD_PHASE_SKIN,
-            normalized_allowed_linear_error: ALLOWED_LINEAR_ERROR * SKIN_FACTOR / BROAD_PHASE_SKIN,
-            normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR
-                / BROAD_PHASE_SKIN,
-            normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR
-                / BROAD_PHASE_SKIN,
+            length_unit: skin / SKIN_FACTOR,
+            normalized_prediction_distance: prediction * SKIN_FACTOR / skin,
+            normalized_allowed_linear_error: ALLOWED_LINEAR_ERROR * SKIN_FACTOR / skin,
+            normalized_contact_recycle_distance: CONTACT_RECYCLE_DISTANCE * SKIN_FACTOR / skin,
+            normalized_max_corrective_velocity: MAX_CORRECTIVE_VELOCITY * SKIN_FACTOR / skin,
             normalized_max_linear_velocity: 1e4,
             // Agents are set to their walking velocity every step and only need to not
-            // overlap: one iteration suffices, and CCD is useless at 2 mm per step.
+            // overlap: one iteration suffices, and CCD is useless at 3 mm per step.
             num_solver_iterations: 1,
             max_ccd_substeps: 0,
             ..IntegrationParameters::default()
@@ -318,6 +325,27 @@ impl Scene {
         }
     }
 
+    /// Broad-phase skin for `world` at step `dt`, metres: [`SPARSE_SKIN_STEPS`] steps of
+    /// travel when the swarm is sparse enough that such fat AABBs rarely overlap (agents are
+    /// held in D(t), so the density is agents / (l × height)), else [`DENSE_SKIN`].
+    pub(crate) fn broad_phase_skin(world: &World, dt: f64) -> f64 {
+        let sparse = SPARSE_SKIN_STEPS * world.swarm.speed * dt;
+        let area = world.leader.window.min(world.arena.width) * world.arena.height;
+        let density = world.swarm.agents as f64 / area;
+        let radius = world
+            .swarm
+            .body_radius
+            .max(world.swarm.detection_radius / 2.0);
+        let side = 2.0 * (sparse + radius);
+        // Two colliders (solid and sensor) per agent.
+        let neighbours = 2.0 * density * side * side;
+        if sparse > DENSE_SKIN && neighbours <= SPARSE_MAX_NEIGHBOURS {
+            sparse
+        } else {
+            DENSE_SKIN
+        }
+    }
+
     /// Gap below which Rapier reports a contact pair (and creates speculative contacts),
     /// metres.
     pub(crate) fn prediction_distance(world: &World, dt: f64) -> f64 {
@@ -333,21 +361,26 @@ impl Scene {
     /// Sets agent `i` moving with velocity `vel` (m/s), or static (translations locked)
     /// when `vel` is `None`.
     pub(crate) fn set_motion(&mut self, i: usize, vel: Option<(f64, f64)>) {
-        let body = &mut self.bodies[self.agents[i]];
+        let handle = self.agents[i];
+        // `IndexMut` on the body set flags the body as modified by the user, which costs it
+        // a pass of Rapier's change tracking (islands, colliders, NaN checks) in the next
+        // step: look first, and borrow mutably only to change something.
+        let body = &self.bodies[handle];
+        let locked = body.is_translation_locked();
         match vel {
             Some((vx, vy)) => {
-                if body.is_translation_locked() {
-                    body.lock_translations(false, true);
-                }
-                // Setting a body's velocity flags it as modified by the user, which costs a
-                // pass of Rapier's change tracking: skip it when nothing changes.
                 let target = v(vx, vy);
-                if body.linvel() != target {
+                if locked || body.linvel() != target {
+                    let body = &mut self.bodies[handle];
+                    if locked {
+                        body.lock_translations(false, true);
+                    }
                     body.set_linvel(target, true);
                 }
             }
             None => {
-                if !body.is_translation_locked() {
+                if !locked {
+                    let body = &mut self.bodies[handle];
                     body.lock_translations(true, true);
                     body.set_linvel(Vector::ZERO, true);
                 }

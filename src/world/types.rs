@@ -101,7 +101,7 @@ pub struct LeaderParams {
 /// Time stepping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulationParams {
-    /// Physics time step in seconds (default: `0.02`).
+    /// Physics time step in seconds (default: `0.03`; see `docs/simulation.md`, "Time step").
     pub dt: f64,
     /// Dispersion time in seconds before the leader starts (default: `300.0`).
     pub dispersion_time: f64,
@@ -110,7 +110,7 @@ pub struct SimulationParams {
 impl Default for SimulationParams {
     fn default() -> Self {
         Self {
-            dt: 0.02,
+            dt: 0.03,
             dispersion_time: 300.0,
         }
     }
