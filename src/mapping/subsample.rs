@@ -29,7 +29,8 @@ pub struct Subsample {
 pub struct SubsampleParams {
     /// Number of representatives m (default: `400`).
     pub m: usize,
-    /// Candidates per kept representative (default: `1.5`).
+    /// Candidates per kept representative (default: `1.0`: outliers are dropped from the m
+    /// picks, so a window may keep slightly fewer than m).
     pub oversample: f64,
     /// Neighbour rank k of the density estimate (default: `8`).
     pub k: usize,
@@ -42,7 +43,7 @@ impl Default for SubsampleParams {
     fn default() -> Self {
         Self {
             m: 400,
-            oversample: 1.5,
+            oversample: 1.0,
             k: 8,
             outlier_factor: 3.0,
         }
