@@ -58,7 +58,7 @@ fn run_to(dir: &Path, world: &World, seed: u64) {
 /// then update the constant and say why in the commit message.
 ///
 /// Last changed: the default step went from 0.02 s to 0.03 s and sparse swarms got a wider
-/// broad-phase skin (both change the trajectories; see `docs/simulation.md`).
+/// broad-phase skin (both change the trajectories; see the README, "The simulation").
 const GOLDEN: &str = "e521bf2692bf7967dbf6cfbb52d750244de0cf1a5566575819e60ccfdda9eede";
 
 #[test]

@@ -1,6 +1,6 @@
 //! The files of a run. Each is rendered to bytes by its own function and written
 //! atomically; numbers use fixed formats (`{:.6}` for seconds and metres) so that the same
-//! run always gives the same bytes. Columns are documented in `docs/simulation.md`.
+//! run always gives the same bytes. Columns are documented in the README ("Output files").
 
 use super::engine::{LEADER_INTERVAL, RETURN_NOISE};
 use super::params::{SimError, SimOutput, Trajectories};

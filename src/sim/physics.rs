@@ -44,7 +44,7 @@ const SKIN_FACTOR: f32 = 0.04;
 /// its incremental optimiser and a full refit every step; below that it relocates each
 /// moved leaf by SAH re-insertion and refits only their ancestors. Dense swarms are
 /// always in the first regime, where a small skin is best (fewer candidate pairs);
-/// 0.5–1 cm measured equal, 1.5 cm and more slower (`docs/simulation.md`).
+/// 0.5–1 cm measured equal, 1.5 cm and more slower (README, "Broad-phase skin").
 const DENSE_SKIN: f64 = 0.01;
 /// Sparse skin, in steps of travel at `speed`: fewer than 1/16 of the moving leaves
 /// (1/25.6) leave their fat AABB per step, so the BVH stays in the re-insertion regime.

@@ -101,7 +101,7 @@ pub struct LeaderParams {
 /// Time stepping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulationParams {
-    /// Physics time step in seconds (default: `0.03`; see `docs/simulation.md`, "Time step").
+    /// Physics time step in seconds (default: `0.03`; see the README, "The simulation" / "Time step").
     pub dt: f64,
     /// Dispersion time in seconds before the leader starts (default: `300.0`).
     pub dispersion_time: f64,
