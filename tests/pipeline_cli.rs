@@ -1,0 +1,162 @@
+//! End to end: `run`, `map` on a log without truth, malformed logs, `eval` resuming, and
+//! determinism of the mapping outputs.
+
+use assert_cmd::Command;
+use predicates::str::contains;
+use std::fs;
+use std::path::Path;
+
+const TINY: &str = "tests/fixtures/worlds/tiny.ron";
+
+fn swarmmap() -> Command {
+    Command::cargo_bin("swarmmap").unwrap()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// `summary.json` without its `timings`, the only part that depends on the machine.
+fn summary_without_timings(dir: &Path) -> serde_json::Value {
+    let mut v = json(&dir.join("summary.json"));
+    v.as_object_mut().unwrap().remove("timings");
+    v
+}
+
+#[test]
+fn run_writes_every_output_and_is_deterministic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    for dir in [&a, &b] {
+        swarmmap()
+            .args(["run", TINY, "--quiet", "--out"])
+            .arg(dir)
+            .assert()
+            .success()
+            .stdout(contains("global (β0,β1)"));
+    }
+    for f in [
+        "encounters.csv",
+        "static_intervals.csv",
+        "leader.csv",
+        "meta.json",
+        "summary.json",
+    ] {
+        assert!(a.join(f).exists(), "{f} missing");
+    }
+    let s = json(&a.join("summary.json"));
+    assert_eq!(s["world"], "tiny");
+    assert_eq!(s["windows"].as_array().unwrap().len(), 2);
+    assert_eq!(s["connections"].as_array().unwrap().len(), 1);
+    // Truth is known for a simulated run: the whole arena has one component and one hole.
+    assert_eq!(s["global"]["truth"], serde_json::json!([1, 1]));
+    for w in s["windows"].as_array().unwrap() {
+        assert!(w["truth"].is_array(), "{w}");
+        assert!(w["events"].as_u64().unwrap() > 0);
+    }
+    for i in 1..=2 {
+        let wa = fs::read(a.join(format!("maps/window_{i}.json"))).unwrap();
+        let wb = fs::read(b.join(format!("maps/window_{i}.json"))).unwrap();
+        assert!(wa == wb, "window {i} differs between identical runs");
+    }
+    assert_eq!(summary_without_timings(&a), summary_without_timings(&b));
+}
+
+#[test]
+fn a_log_without_truth_or_world_maps_without_truth() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("run");
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    // Strip the truth columns and the metadata: what a real experiment would record.
+    let log = tmp.path().join("log");
+    fs::create_dir_all(&log).unwrap();
+    let text = fs::read_to_string(run.join("encounters.csv")).unwrap();
+    let stripped: String = text
+        .lines()
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    fs::write(log.join("encounters.csv"), stripped).unwrap();
+    fs::copy(
+        run.join("static_intervals.csv"),
+        log.join("static_intervals.csv"),
+    )
+    .unwrap();
+    swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .arg(&log)
+        .assert()
+        .success();
+    let s = json(&log.join("summary.json"));
+    assert_eq!(s["world"], "log");
+    let windows = s["windows"].as_array().unwrap();
+    assert_eq!(windows.len(), 2);
+    assert!(windows.iter().all(|w| w["truth"].is_null()));
+    assert!(s["global"]["truth"].is_null());
+}
+
+#[test]
+fn a_malformed_log_names_the_line_and_exits_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    fs::write(
+        tmp.path().join("encounters.csv"),
+        "start,end,a,b\n1.0,2.0,0,1\n3.0,oops,1,2\n",
+    )
+    .unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(tmp.path())
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "encounters.csv:3: column `end` is `oops`, which is not a number",
+        ));
+    fs::write(
+        tmp.path().join("encounters.csv"),
+        "start,end,a,b\n5.0,2.0,0,1\n",
+    )
+    .unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(tmp.path())
+        .assert()
+        .code(2)
+        .stderr(contains("encounters.csv:2: end 2 is before start 5"));
+}
+
+#[test]
+fn eval_writes_one_row_per_run_and_resumes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("eval");
+    let args = [
+        "eval", TINY, "--seeds", "1..2", "--jobs", "2", "--quiet", "--out",
+    ];
+    swarmmap()
+        .args(args)
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("tiny"));
+    let csv = fs::read_to_string(out.join("eval.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    let stored: Vec<_> = fs::read_dir(out.join("runs")).unwrap().collect();
+    assert_eq!(stored.len(), 2);
+    // A rerun finds both runs done and writes the same rows.
+    let before = fs::metadata(out.join("runs")).unwrap().modified().unwrap();
+    swarmmap().args(args).arg(&out).assert().success();
+    assert_eq!(fs::read_to_string(out.join("eval.csv")).unwrap(), csv);
+    assert_eq!(
+        fs::metadata(out.join("runs")).unwrap().modified().unwrap(),
+        before
+    );
+    // A typo in a sweep fails at once, with status 2.
+    swarmmap()
+        .args(["eval", TINY, "--set", "swarm.agentz=10", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains("agentz"));
+}
