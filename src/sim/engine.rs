@@ -64,7 +64,7 @@ struct Agent {
     /// Outward normals of the contacts that started at the last step.
     normals: Vec<P>,
     /// Boxed: the generator's state and block buffer (≈ 300 bytes) would otherwise make
-    /// the per-step passes over all agents stream through five times more memory.
+    /// the per-step passes over all agents stream through about four times more memory.
     rng: Box<ChaCha8Rng>,
 }
 
