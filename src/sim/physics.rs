@@ -352,10 +352,18 @@ impl Scene {
         (PREDICTION_STEPS * world.swarm.speed * dt).max(MIN_PREDICTION_DISTANCE)
     }
 
-    /// Current position of agent `i`, metres.
-    pub(crate) fn position(&self, i: usize) -> (f64, f64) {
-        let t = self.bodies[self.agents[i]].translation();
-        (f64::from(t.x), f64::from(t.y))
+    /// Writes every agent's position (metres) into `out` (one slot per agent) and returns
+    /// the first agent whose position is not finite, if any.
+    pub(crate) fn read_positions(&self, out: &mut [(f64, f64)]) -> Option<usize> {
+        let mut bad = None;
+        for (i, (slot, &h)) in out.iter_mut().zip(&self.agents).enumerate() {
+            let t = self.bodies[h].translation();
+            if bad.is_none() && !(t.x.is_finite() && t.y.is_finite()) {
+                bad = Some(i);
+            }
+            *slot = (f64::from(t.x), f64::from(t.y));
+        }
+        bad
     }
 
     /// Sets agent `i` moving with velocity `vel` (m/s), or static (translations locked)
