@@ -163,14 +163,28 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         .cloned()
         .collect();
     let graph = EncounterGraph::build(&enc, &statics, p.bridging);
+    // Whether an encounter involves an agent that was a landmark at the time: its position
+    // is the landmark's. Landmark intervals are indexed by agent, so this is O(E · k) for
+    // k intervals per agent, not O(E · all intervals).
+    let mut landmark_of: std::collections::HashMap<u32, Vec<(f64, f64)>> =
+        std::collections::HashMap::new();
+    for s in statics
+        .iter()
+        .filter(|s| s.reason == crate::log::StaticReason::Landmark)
+    {
+        landmark_of
+            .entry(s.agent)
+            .or_default()
+            .push((s.start, s.end));
+    }
     let anchored: Vec<bool> = enc
         .iter()
         .map(|e| {
-            statics.iter().any(|s| {
-                s.reason == crate::log::StaticReason::Landmark
-                    && (s.agent == e.a || s.agent == e.b)
-                    && s.start <= e.end
-                    && e.start <= s.end
+            [e.a, e.b].iter().any(|agent| {
+                landmark_of.get(agent).is_some_and(|v| {
+                    v.iter()
+                        .any(|&(start, end)| start <= e.end && e.start <= end)
+                })
             })
         })
         .collect();
