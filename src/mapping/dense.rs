@@ -58,7 +58,12 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
     }
     let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
     // Cells holding about k points each.
-    let cell = (area * k as f64 / n as f64).sqrt().max(1e-12);
+    // A nearly collinear cloud has a tiny area: size cells by the longer side too.
+    let side = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let cell = (area * k as f64 / n as f64)
+        .sqrt()
+        .max(side * k as f64 / n as f64)
+        .max(1e-12);
     let key = |p: &[f64; 3]| {
         (
             ((p[0] - lo[0]) / cell).floor() as i64,
@@ -78,6 +83,19 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
             let mut ring = 1i64;
             loop {
                 d.clear();
+                // Once the ring spans more cells than are occupied, scanning the occupied
+                // cells is cheaper than walking mostly empty ones (a far outlier would
+                // otherwise need a ring of millions of cells).
+                let exhaustive = (2 * ring + 1).saturating_mul(2 * ring + 1) >= grid.len() as i64;
+                if exhaustive {
+                    d.extend(
+                        (0..n)
+                            .filter(|&j| j != i)
+                            .map(|j| dist(p, &points[j], dims)),
+                    );
+                    d.select_nth_unstable_by(k - 1, f64::total_cmp);
+                    return d[k - 1];
+                }
                 for x in cx - ring..=cx + ring {
                     for y in cy - ring..=cy + ring {
                         if let Some(v) = grid.get(&(x, y)) {
@@ -92,11 +110,9 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
                 // The k-th distance is exact once it is within the searched ring.
                 if d.len() >= k {
                     d.select_nth_unstable_by(k - 1, f64::total_cmp);
-                    if d[k - 1] <= ring as f64 * cell || d.len() >= n - 1 {
+                    if d[k - 1] <= ring as f64 * cell {
                         return d[k - 1];
                     }
-                } else if d.len() >= n - 1 {
-                    return d.iter().copied().fold(0.0, f64::max);
                 }
                 ring *= 2;
             }
@@ -173,6 +189,46 @@ mod tests {
                 r[i],
                 d[4]
             );
+        }
+    }
+
+    /// Regression: a far-away handful of points (an embedding outlier) made the ring search
+    /// walk millions of empty cells (`swarmmap eval worlds/touching.ron` ran for minutes).
+    #[test]
+    fn far_outliers_do_not_stall_the_search() {
+        let mut pts: Vec<[f64; 3]> = (0..2000)
+            .map(|i| [(i % 50) as f64 * 0.1, (i / 50) as f64 * 0.1, 0.0])
+            .collect();
+        pts.extend([[1e7, 1e7, 0.0], [1e7 + 1.0, 1e7, 0.0], [-1e7, 3.0, 0.0]]);
+        // And a nearly collinear cloud (a degenerate second MDS axis): tiny cells.
+        let line: Vec<[f64; 3]> = (0..3000)
+            .map(|i| [i as f64, 1e-9 * (i % 7) as f64, 0.0])
+            .collect();
+        let t = std::time::Instant::now();
+        let r = knn_radius(&line, 5, 2);
+        assert!(
+            t.elapsed().as_secs_f64() < 5.0,
+            "line took {:?}",
+            t.elapsed()
+        );
+        assert!((r[1500] - 3.0).abs() < 1e-6, "{}", r[1500]);
+        let t = std::time::Instant::now();
+        let r = knn_radius(&pts, 5, 2);
+        assert!(t.elapsed().as_secs_f64() < 5.0, "took {:?}", t.elapsed());
+        for (i, p) in pts
+            .iter()
+            .enumerate()
+            .step_by(97)
+            .chain((2000..2003).map(|i| (i, &pts[i])))
+        {
+            let mut d: Vec<f64> = pts
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| dist(p, q, 2))
+                .collect();
+            d.sort_by(f64::total_cmp);
+            assert_eq!(r[i], d[4], "point {i}");
         }
     }
 
