@@ -162,6 +162,18 @@ pub fn dense_maxmin(points: &[[f64; 3]], p: &DenseParams) -> Vec<usize> {
 mod tests {
     use super::*;
 
+    /// The k-th nearest-neighbour distance of point `i` by brute force (the oracle).
+    fn brute_kth(pts: &[[f64; 3]], i: usize, k: usize) -> f64 {
+        let mut d: Vec<f64> = pts
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, q)| dist(&pts[i], q, 2))
+            .collect();
+        d.sort_by(f64::total_cmp);
+        d[k - 1]
+    }
+
     #[test]
     fn knn_matches_brute_force() {
         let pts: Vec<[f64; 3]> = (0..300)
@@ -175,20 +187,9 @@ mod tests {
             })
             .collect();
         let r = knn_radius(&pts, 5, 2);
-        for (i, p) in pts.iter().enumerate() {
-            let mut d: Vec<f64> = pts
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, q)| dist(p, q, 2))
-                .collect();
-            d.sort_by(f64::total_cmp);
-            assert!(
-                (r[i] - d[4]).abs() < 1e-12,
-                "point {i}: {} vs {}",
-                r[i],
-                d[4]
-            );
+        for (i, got) in r.iter().enumerate() {
+            let want = brute_kth(&pts, i, 5);
+            assert!((got - want).abs() < 1e-12, "point {i}: {got} vs {want}");
         }
     }
 
@@ -215,20 +216,8 @@ mod tests {
         let t = std::time::Instant::now();
         let r = knn_radius(&pts, 5, 2);
         assert!(t.elapsed().as_secs_f64() < 5.0, "took {:?}", t.elapsed());
-        for (i, p) in pts
-            .iter()
-            .enumerate()
-            .step_by(97)
-            .chain((2000..2003).map(|i| (i, &pts[i])))
-        {
-            let mut d: Vec<f64> = pts
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, q)| dist(p, q, 2))
-                .collect();
-            d.sort_by(f64::total_cmp);
-            assert_eq!(r[i], d[4], "point {i}");
+        for i in (0..2000).step_by(97).chain(2000..2003) {
+            assert_eq!(r[i], brute_kth(&pts, i, 5), "point {i}");
         }
     }
 
