@@ -1,9 +1,13 @@
 //! Mapping one window of a synthetic log (issue #4 §6): targets 10⁴ encounters under 2 s and
 //! 10⁵ under 20 s, cost linear in encounters for a fixed subsample size m.
 //!
+//! The `local_map_scaling` group holds the swarm fixed (300 agents, 30 landmarks) and grows
+//! the window's encounters from 12 500 to 100 000, reporting throughput (encounters/s):
+//! a flat throughput is linear cost. `cargo bench --bench mapping -- scaling` runs it alone.
+//!
 //! `cargo bench --bench mapping`
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use swarmmap::mapping::local::{LocalParams, local_map};
 use swarmmap::mapping::synthetic::{SyntheticParams, synthetic_log};
 use swarmmap::mapping::windows::Window;
@@ -32,5 +36,30 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+fn scaling(c: &mut Criterion) {
+    let mut g = c.benchmark_group("local_map_scaling");
+    g.sample_size(10);
+    let p = SyntheticParams {
+        agents: 300,
+        landmarks: 30,
+        ..Default::default()
+    };
+    let params = LocalParams::default();
+    for n in [12_500usize, 25_000, 50_000, 100_000] {
+        let log = synthetic_log(&p, n);
+        let (a, b) = log.span().expect("non-empty log");
+        let w = Window {
+            index: 1,
+            start: a,
+            end: b,
+        };
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(format!("{n}_encounters_300_agents"), |bch| {
+            bch.iter(|| local_map(&log, &w, &params))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, scaling);
 criterion_main!(benches);

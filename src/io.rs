@@ -4,10 +4,41 @@
 //! is created with the mode an ordinary `File::create` uses (0666, reduced by the process
 //! umask: 0644 under the usual 022), not the owner-only 0600 of `tempfile`'s default, so
 //! outputs are readable like any other file the user writes.
+//!
+//! Interrupts: a signal kills the process between any two instructions, possibly while a
+//! temporary file is half written. [`install_interrupt_handler`] (called by the command
+//! line) catches Ctrl-C (SIGINT, SIGTERM, SIGHUP), removes the temporary files still in
+//! flight (every target keeps its previous content or is absent) and exits with status
+//! 130, so an interrupted run leaves only whole files behind, and no debris.
 
 use std::fs;
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
+
+/// Temporary files being written, removed by the interrupt handler.
+static IN_FLIGHT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn in_flight() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    IN_FLIGHT.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Exit status of a run stopped by Ctrl-C (128 + SIGINT, the shell convention).
+pub const INTERRUPTED_STATUS: i32 = 130;
+
+/// Installs the process-wide Ctrl-C handler described in the module docs. Call it once,
+/// from a binary; a second call returns an error.
+pub fn install_interrupt_handler() -> Result<(), ctrlc::Error> {
+    ctrlc::set_handler(|| {
+        // Held until exit: no write may register (or rename) a file after the sweep.
+        let files = in_flight();
+        for f in files.iter() {
+            let _ = fs::remove_file(f);
+        }
+        eprintln!("interrupted: files already written are complete; partial ones were removed");
+        std::process::exit(INTERRUPTED_STATUS);
+    })
+}
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
@@ -33,15 +64,32 @@ where
         // Subject to the umask, exactly as `File::create`.
         builder.permissions(fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir)?;
-    {
-        let mut w = io::BufWriter::new(tmp.as_file_mut());
-        fill(&mut w)?;
-        w.flush()?;
+    // Created and registered under the lock: the interrupt handler holds it from its sweep
+    // until exit, so no temporary file can appear after the sweep.
+    let (mut tmp, tmp_path) = {
+        let mut files = in_flight();
+        let tmp = builder.tempfile_in(dir)?;
+        let tmp_path = tmp.path().to_path_buf();
+        files.push(tmp_path.clone());
+        (tmp, tmp_path)
+    };
+    let result = (|| {
+        {
+            let mut w = io::BufWriter::new(tmp.as_file_mut());
+            fill(&mut w)?;
+            w.flush()?;
+        }
+        tmp.as_file().sync_all()?;
+        // Renamed under the lock, so the interrupt handler sees either the temporary file
+        // (and removes it) or the finished target, never a half-done rename.
+        let mut files = in_flight();
+        files.retain(|f| f != &tmp_path);
+        tmp.persist(path).map(|_| ()).map_err(|e| e.error)
+    })();
+    if result.is_err() {
+        in_flight().retain(|f| f != &tmp_path);
     }
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    result
 }
 
 #[cfg(test)]

@@ -89,6 +89,9 @@ enum Command {
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = swarmmap::io::install_interrupt_handler() {
+        eprintln!("warning: Ctrl-C will not clean up partial files: {e}");
+    }
     let result: Result<(), Failure> = match cli.command {
         Command::Check(args) => check::run(&args),
         Command::Simulate(args) => simulate::run(&args),

@@ -1,0 +1,106 @@
+//! Ctrl-C never leaves a torn file (issue #5 §2): `swarmmap run` is interrupted with
+//! SIGINT at a sweep of moments, from start-up to completion, and after each interrupt
+//! every file in the output directory must be byte-identical to the same file of an
+//! uninterrupted run with the same seed (files with wall-clock timings must parse whole),
+//! and no temporary file may remain.
+
+#![cfg(unix)]
+
+use std::collections::BTreeMap;
+use std::os::unix::process::ExitStatusExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+const WORLD: &str = "tests/fixtures/worlds/tiny.ron";
+/// Files whose content includes wall-clock timings: compared by parsing, not by bytes.
+const TIMED: [&str; 2] = ["meta.json", "summary.json"];
+
+fn run(out: &Path) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_swarmmap"));
+    c.args(["run", WORLD, "--quiet", "--trajectories", "0.05", "--out"])
+        .arg(out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    c
+}
+
+/// Every file under `dir`, by path relative to `dir`.
+fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().to_path_buf();
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn interrupting_a_run_leaves_only_whole_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let reference = tmp.path().join("reference");
+    let t0 = Instant::now();
+    assert!(run(&reference).status().unwrap().success());
+    let full = t0.elapsed();
+    let expected = files(&reference);
+    assert!(
+        expected.len() >= 8,
+        "reference run wrote {:?}",
+        expected.keys()
+    );
+
+    // Interrupt at 24 moments spread over (and a little beyond) a whole run.
+    let (mut interrupted, mut finished, mut partial) = (0, 0, 0);
+    for k in 0..24u32 {
+        let out = tmp.path().join(format!("run{k}"));
+        let mut child = run(&out).spawn().unwrap();
+        std::thread::sleep(full.mul_f64(f64::from(k) / 20.0));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        let status = child.wait().unwrap();
+        match (status.code(), status.signal()) {
+            (Some(0), _) => finished += 1,
+            // 130: our handler; SIGINT itself: before the handler was installed.
+            (Some(130), _) | (None, Some(2)) => interrupted += 1,
+            other => panic!("interrupt {k}: unexpected exit {other:?}"),
+        }
+        let written = files(&out);
+        if status.code() != Some(0) && !written.is_empty() {
+            partial += 1;
+        }
+        for (rel, bytes) in written {
+            let name = rel.file_name().unwrap().to_string_lossy().to_string();
+            assert!(
+                !name.ends_with(".tmp"),
+                "interrupt {k}: temporary file {rel:?} left behind"
+            );
+            let want = expected
+                .get(&rel)
+                .unwrap_or_else(|| panic!("interrupt {k}: unexpected file {rel:?}"));
+            if TIMED.contains(&name.as_str()) {
+                serde_json::from_slice::<serde_json::Value>(&bytes)
+                    .unwrap_or_else(|e| panic!("interrupt {k}: {rel:?} is torn: {e}"));
+            } else {
+                assert!(&bytes == want, "interrupt {k}: {rel:?} differs (torn)");
+            }
+        }
+    }
+    // The sweep must have caught runs in the act, not only before or after.
+    assert!(interrupted > 0, "no run was interrupted");
+    assert!(finished + interrupted == 24);
+    eprintln!(
+        "{interrupted} interrupted ({partial} with some outputs written), {finished} finished"
+    );
+}
