@@ -187,6 +187,10 @@ pub struct Score {
     /// Windows whose truth has no hole, and how many of them the map shows without one.
     pub holeless: usize,
     pub holeless_ok: usize,
+    /// Windows with a truth-position oracle (`fidelity.oracle`), and how many of those
+    /// oracles equal the truth.
+    pub oracle: usize,
+    pub oracle_ok: usize,
     pub connections: usize,
     pub connections_ok: usize,
     pub global_ok: bool,
@@ -195,6 +199,7 @@ pub struct Score {
     pub time: f64,
     pub window_betti: String,
     pub window_truth: String,
+    pub window_oracle: String,
     pub global: String,
     pub global_truth: String,
 }
@@ -206,7 +211,7 @@ fn pair(v: &serde_json::Value) -> Option<[u64; 2]> {
 /// Scores a stored summary.
 pub fn score(summary: &serde_json::Value) -> Score {
     let mut s = Score::default();
-    let (mut est, mut tru) = (Vec::new(), Vec::new());
+    let (mut est, mut tru, mut ora) = (Vec::new(), Vec::new(), Vec::new());
     for w in summary["windows"].as_array().into_iter().flatten() {
         let (Some(b), t) = (pair(&w["betti"]), pair(&w["truth"])) else {
             continue;
@@ -221,6 +226,11 @@ pub fn score(summary: &serde_json::Value) -> Score {
             if t[1] == 0 {
                 s.holeless += 1;
                 s.holeless_ok += usize::from(b[1] == 0);
+            }
+            if let Some(o) = pair(&w["fidelity"]["oracle"]) {
+                ora.push(format!("{}:{}", o[0], o[1]));
+                s.oracle += 1;
+                s.oracle_ok += usize::from(o == t);
             }
         }
         if let Some(x) = w["fidelity"]["spearman"].as_f64() {
@@ -248,6 +258,7 @@ pub fn score(summary: &serde_json::Value) -> Score {
         .unwrap_or(0.0);
     s.window_betti = est.join(" ");
     s.window_truth = tru.join(" ");
+    s.window_oracle = ora.join(" ");
     s
 }
 
@@ -262,14 +273,14 @@ fn mean(v: &[f64]) -> f64 {
 /// `eval.csv`: one row per run.
 pub fn csv(records: &[RunRecord]) -> String {
     let mut out = String::from(
-        "world,params,seed,windows,windows_ok,b0_ok,b1_ok,holeless,holeless_ok,connections,\
-         connections_ok,global,global_truth,global_ok,spearman,procrustes,seconds,\
-         window_betti,window_truth,error\n",
+        "world,params,seed,windows,windows_ok,b0_ok,b1_ok,holeless,holeless_ok,oracle_ok,\
+         connections,connections_ok,global,global_truth,global_ok,spearman,procrustes,seconds,\
+         window_betti,window_truth,window_oracle,error\n",
     );
     for r in records {
         let s = r.summary.as_ref().map(score).unwrap_or_default();
         out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{}\n",
             r.world,
             quote(&r.params),
             r.seed,
@@ -279,6 +290,7 @@ pub fn csv(records: &[RunRecord]) -> String {
             s.b1_ok,
             s.holeless,
             s.holeless_ok,
+            s.oracle_ok,
             s.connections,
             s.connections_ok,
             s.global,
@@ -289,6 +301,7 @@ pub fn csv(records: &[RunRecord]) -> String {
             s.time,
             s.window_betti,
             s.window_truth,
+            s.window_oracle,
             quote(r.error.as_deref().unwrap_or("")),
         ));
     }
@@ -313,7 +326,7 @@ pub fn table(records: &[RunRecord]) -> String {
             .push(r);
     }
     let mut out = String::from(
-        "world        params                          runs fail  windows ok  β0 ok   β1 ok   no-hole ok  conn ok   global ok  spearman  procr.  s/run\n",
+        "world        params                          runs fail  windows ok  β0 ok   β1 ok   no-hole ok  oracle ok  conn ok   global ok  spearman  procr.  s/run\n",
     );
     let pct = |a: usize, b: usize| {
         if b == 0 {
@@ -335,7 +348,7 @@ pub fn table(records: &[RunRecord]) -> String {
         let pr: Vec<f64> = scores.iter().flat_map(|s| s.procrustes.clone()).collect();
         let times: Vec<f64> = scores.iter().map(|s| s.time).collect();
         out.push_str(&format!(
-            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>10}  {:>7}  {:>9}  {:>8.2}  {:>6.3}  {:>5.1}\n",
+            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>10}  {:>9}  {:>7}  {:>9}  {:>8.2}  {:>6.3}  {:>5.1}\n",
             world,
             if params.is_empty() { "(defaults)" } else { params },
             rs.len(),
@@ -344,6 +357,7 @@ pub fn table(records: &[RunRecord]) -> String {
             pct(sum(|s| s.b0_ok), w),
             pct(sum(|s| s.b1_ok), w),
             pct(sum(|s| s.holeless_ok), sum(|s| s.holeless)),
+            pct(sum(|s| s.oracle_ok), sum(|s| s.oracle)),
             pct(sum(|s| s.connections_ok), sum(|s| s.connections)),
             pct(scores.iter().filter(|s| s.global_ok).count(), scores.len()),
             mean(&sp),
@@ -386,7 +400,7 @@ mod tests {
         let v = serde_json::json!({
             "windows": [
                 {"betti": [1, 0], "truth": [1, 0], "fidelity": {"spearman": 0.5, "procrustes": null}},
-                {"betti": [1, 1], "truth": [2, 1], "fidelity": {}},
+                {"betti": [1, 1], "truth": [2, 1], "fidelity": {"oracle": [2, 1]}},
             ],
             "connections": [{"count": 2, "truth": 2}, {"count": 1, "truth": 2}],
             "global": {"betti": [1, 1], "truth": [1, 1]},
@@ -399,5 +413,7 @@ mod tests {
         assert!(s.global_ok);
         assert_eq!(s.time, 3.0);
         assert_eq!(s.window_betti, "1:0 1:1");
+        assert_eq!((s.oracle, s.oracle_ok), (1, 1));
+        assert_eq!(s.window_oracle, "2:1");
     }
 }

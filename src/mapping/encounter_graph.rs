@@ -41,8 +41,7 @@
 //! measured by `swarmmap eval`.
 
 use crate::log::{AgentId, Encounter, StaticInterval};
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::HashMap;
 
 /// How static intervals bridge time in the metric.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -183,14 +182,18 @@ impl EncounterGraph {
     }
 
     /// Shortest-path distances (seconds) from encounter `source` to every encounter
-    /// (`f64::INFINITY` where unreachable). Dijkstra with a binary heap: O((V + E) log V).
+    /// (`f64::INFINITY` where unreachable). Dijkstra with a monotone radix heap
+    /// ([`RadixHeap`]): O(E + V · 64) rather than a binary heap's O((V + E) log V), and
+    /// cache-friendly, which keeps the cost per encounter flat as windows grow. The result
+    /// does not depend on the order in which equal keys pop (each distance is the minimum
+    /// over its neighbours' final distances), so it is deterministic.
     pub fn distances_from(&self, source: usize) -> Vec<f64> {
         let mut dist = vec![f64::INFINITY; self.vertices()];
-        let mut heap = BinaryHeap::new();
+        let mut heap = RadixHeap::new();
         dist[source] = 0.0;
         // Non-negative f64 bit patterns order like the numbers, so u64 keys are exact.
-        heap.push(Reverse((0f64.to_bits(), source as u32)));
-        while let Some(Reverse((bits, u))) = heap.pop() {
+        heap.push(0f64.to_bits(), source as u32);
+        while let Some((bits, u)) = heap.pop() {
             let d = f64::from_bits(bits);
             let u = u as usize;
             if d > dist[u] {
@@ -201,7 +204,7 @@ impl EncounterGraph {
                 let nd = d + self.weights[k];
                 if nd < dist[v] {
                     dist[v] = nd;
-                    heap.push(Reverse((nd.to_bits(), v as u32)));
+                    heap.push(nd.to_bits(), v as u32);
                 }
             }
         }
@@ -245,12 +248,98 @@ impl EncounterGraph {
     }
 }
 
+/// A monotone priority queue of `(key, vertex)` (Ahuja, Mehlhorn, Orlin & Tarjan 1990):
+/// keys pushed are never below the last key popped, as in Dijkstra with non-negative
+/// weights. Bin 0 holds the keys equal to the last minimum; bin `i` (1..=64) those whose
+/// highest bit differing from it is bit `i − 1`. A push is an append; a pop from an empty
+/// bin 0 takes the first non-empty bin, makes its minimum the new last key and spreads its
+/// entries over lower bins. Each entry moves down at most 64 times.
+struct RadixHeap {
+    last: u64,
+    bins: Vec<Vec<(u64, u32)>>,
+}
+
+impl RadixHeap {
+    fn new() -> Self {
+        Self {
+            last: 0,
+            bins: vec![Vec::new(); 65],
+        }
+    }
+
+    #[inline]
+    fn bin(&self, key: u64) -> usize {
+        64 - (key ^ self.last).leading_zeros() as usize
+    }
+
+    #[inline]
+    fn push(&mut self, key: u64, v: u32) {
+        debug_assert!(key >= self.last, "radix heap keys must be monotone");
+        let i = self.bin(key);
+        self.bins[i].push((key, v));
+    }
+
+    fn pop(&mut self) -> Option<(u64, u32)> {
+        if self.bins[0].is_empty() {
+            let i = self.bins.iter().position(|b| !b.is_empty())?;
+            let bin = std::mem::take(&mut self.bins[i]);
+            self.last = bin.iter().map(|e| e.0).min()?;
+            for &(key, v) in &bin {
+                let j = self.bin(key);
+                self.bins[j].push((key, v));
+            }
+            // Keep the emptied buffer's capacity for the next time this bin fills.
+            let mut bin = bin;
+            bin.clear();
+            if self.bins[i].is_empty() {
+                self.bins[i] = bin;
+            }
+        }
+        self.bins[0].pop()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::log::StaticReason;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// The radix heap pops exactly what a sorted multiset would, under monotone use:
+    /// interleaved pushes (never below the last pop, ties included) and pops.
+    #[test]
+    fn radix_heap_pops_in_key_order() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut heap = RadixHeap::new();
+        let mut oracle: Vec<(u64, u32)> = Vec::new();
+        let mut last = 0f64;
+        for step in 0..20_000u32 {
+            if rng.random_range(0..3) > 0 || oracle.is_empty() {
+                // Ties with the last key are frequent, as in Dijkstra's zero-weight edges.
+                let key = if rng.random_range(0..4) == 0 {
+                    last
+                } else {
+                    last + rng.random_range(0.0..100.0)
+                };
+                heap.push(key.to_bits(), step);
+                oracle.push((key.to_bits(), step));
+            } else {
+                let (k, _) = heap.pop().unwrap();
+                let min = oracle.iter().map(|e| e.0).min().unwrap();
+                assert_eq!(k, min);
+                let at = oracle.iter().position(|e| e.0 == k).unwrap();
+                oracle.swap_remove(at);
+                last = f64::from_bits(k);
+            }
+        }
+        while let Some((k, _)) = heap.pop() {
+            assert_eq!(k, oracle.iter().map(|e| e.0).min().unwrap());
+            let at = oracle.iter().position(|e| e.0 == k).unwrap();
+            oracle.swap_remove(at);
+        }
+        assert!(oracle.is_empty());
+    }
 
     fn gap(x: &Encounter, y: &Encounter) -> f64 {
         (x.start.max(y.start) - x.end.min(y.end)).max(0.0)

@@ -15,6 +15,13 @@ pub struct Fidelity {
     /// RMS Procrustes residual of the embedding's first two coordinates against the true
     /// positions (similarity fit), divided by the diagonal of the window's domain.
     pub procrustes: Option<f64>,
+    /// (β0, β1) that the topology stage finds on the events' *true* positions: each real
+    /// component's events at their true positions, the same number of representatives
+    /// (density filter + MaxMin), planar Vietoris–Rips and the shipped `Embedded`
+    /// classifier. It separates the two sources of error: a window whose `oracle` is
+    /// right but whose `betti` is wrong lost its features in the metric; one whose
+    /// `oracle` is wrong too lost them in the sampling or the classification.
+    pub oracle: Option<[usize; 2]>,
 }
 
 /// One window's line in `summary.json`.

@@ -2,12 +2,15 @@
 //! Windows are independent, so they are mapped in parallel (rayon); the result does not
 //! depend on the number of threads.
 
+use super::classify::Feature;
 use super::local::{LocalMap, LocalParams, local_map};
 use super::output::{Fidelity, WindowSummary};
 use super::windows::{Window, windows};
 use crate::eval::fidelity::{procrustes_error, spearman};
 use crate::eval::truth::{FreeSpace, window_band};
 use crate::log::EncounterLog;
+use crate::topology::PointCloud;
+use crate::topology::rips::{RipsOptions, rips_points};
 use crate::world::World;
 use rayon::prelude::*;
 
@@ -101,7 +104,47 @@ pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
     Fidelity {
         spearman: rho.is_finite().then_some(rho),
         procrustes,
+        oracle: Some(oracle_betti(map, &truth)),
     }
+}
+
+/// (β0, β1) of the topology stage run on the true positions `truth` (one per event of
+/// `map`) of each real component's events; see [`Fidelity::oracle`].
+fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
+    let classifier = super::classify::Models::shipped()
+        .get(crate::world::MappingMethod::Embedded)
+        .classifier;
+    let mut betti = [0, 0];
+    for c in &map.components {
+        let coords: Vec<[f64; 3]> = c
+            .events
+            .iter()
+            .map(|&j| [truth[j][0], truth[j][1], 0.0])
+            .collect();
+        let params = super::dense::DenseParams {
+            m: c.representatives.len().max(1),
+            ..Default::default()
+        };
+        let picks = super::dense::dense_maxmin(&coords, &params);
+        let rows: Vec<Vec<f64>> = picks.iter().map(|&k| coords[k][..2].to_vec()).collect();
+        let Ok(cloud) = PointCloud::from_rows(&rows) else {
+            continue;
+        };
+        let diagram = rips_points(&cloud, &RipsOptions::default());
+        let features: Vec<Feature> = diagram
+            .bars
+            .iter()
+            .map(|b| Feature {
+                dim: b.dim,
+                birth: b.birth,
+                death: b.death,
+            })
+            .collect();
+        let b = classifier.betti(&features);
+        betti[0] += b[0];
+        betti[1] += b[1];
+    }
+    betti
 }
 
 /// The summary line of each window; with a world, its truth and fidelity too.
@@ -131,4 +174,74 @@ pub fn summarise(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod oracle_tests {
+    use super::*;
+    use crate::log::Encounter;
+    use crate::mapping::local::Component;
+    use rand::{RngExt, SeedableRng};
+
+    /// A one-component map whose events lie, in truth, uniformly in the region
+    /// `keep` of the square [-2, 2]²; the map's own points are meaningless (zeros).
+    fn map_over(keep: impl Fn(f64, f64) -> bool) -> (LocalMap, Vec<[f64; 2]>) {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut truth = Vec::new();
+        while truth.len() < 2000 {
+            let (x, y) = (rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
+            if keep(x, y) {
+                truth.push([x, y]);
+            }
+        }
+        let n = truth.len();
+        let map = LocalMap {
+            index: 1,
+            start: 0.0,
+            end: 1.0,
+            events: (0..n).collect(),
+            points: vec![[0.0; 3]; n],
+            noise: vec![false; n],
+            components: vec![Component {
+                events: (0..n).collect(),
+                representatives: (0..300).collect(),
+                scale: 0.0,
+                diagram: Vec::new(),
+                betti: [1, 0],
+                holes: Vec::new(),
+            }],
+            betti: [1, 0],
+            explained: 1.0,
+            rows: Vec::new(),
+        };
+        (map, truth)
+    }
+
+    #[test]
+    fn oracle_sees_the_hole_of_an_annulus_and_none_in_a_disc() {
+        let (map, truth) = map_over(|x, y| (1.0..=2.0).contains(&x.hypot(y)));
+        assert_eq!(oracle_betti(&map, &truth), [1, 1]);
+        let (map, truth) = map_over(|x, y| x.hypot(y) <= 2.0);
+        assert_eq!(oracle_betti(&map, &truth), [1, 0]);
+    }
+
+    #[test]
+    fn fidelity_carries_the_oracle_only_with_truth_columns() {
+        let (map, truth) = map_over(|x, y| (1.0..=2.0).contains(&x.hypot(y)));
+        let mut log = EncounterLog::default();
+        for p in &truth {
+            log.encounters.push(Encounter {
+                start: 0.0,
+                end: 0.0,
+                a: 0,
+                b: 1,
+                truth: Some([p[0], p[1], p[0], p[1]]),
+            });
+        }
+        assert_eq!(fidelity(&map, &log, 1.0).oracle, Some([1, 1]));
+        for e in &mut log.encounters {
+            e.truth = None;
+        }
+        assert_eq!(fidelity(&map, &log, 1.0).oracle, None);
+    }
 }
