@@ -193,7 +193,8 @@ const SCRIPT: &str = r#"
   var canvas = document.getElementById('replay-canvas');
   var ctx = canvas.getContext('2d');
   var W = R.arena[0], H = R.arena[1], pad = 12;
-  var scale = (canvas.width - 2 * pad) / W;
+  var scale = Math.min((960 - 2 * pad) / W, (520 - 2 * pad) / H);
+  canvas.width = Math.round(W * scale + 2 * pad);
   canvas.height = Math.round(H * scale + 2 * pad);
   function px(x) { return pad + x * scale; }
   function py(y) { return pad + (H - y) * scale; }
