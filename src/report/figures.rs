@@ -9,6 +9,7 @@ use super::data::{ComponentIn, ConnectionIn, RunData, WindowIn};
 use crate::world::{Obstacle, World};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 
@@ -83,7 +84,33 @@ fn render(
         draw(&root).map_err(|e| plot(&e))?;
         root.present().map_err(|e| plot(&e))?;
     }
-    Ok(buf)
+    Ok(compact(&buf))
+}
+
+/// Drops what an SVG renderer assumes anyway, to keep the page small: attributes at their
+/// default values (`opacity="1"`, `stroke-width` of an unstroked shape, a circle's
+/// `stroke="none"`) and circles that
+/// repeat an earlier identical one (the same marker at the same pixel draws the same thing;
+/// many encounters share a pixel).
+pub fn compact(svg: &str) -> String {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut out = String::with_capacity(svg.len());
+    for line in svg.split_inclusive('\n') {
+        let line = line
+            .replace(" opacity=\"1\"", "")
+            .replace(" stroke=\"none\" stroke-width=\"1\"", " stroke=\"none\"");
+        // A circle's stroke is none unless set.
+        let line = if line.starts_with("<circle") {
+            line.replace(" stroke=\"none\"", "")
+        } else {
+            line
+        };
+        if line.starts_with("<circle") && !seen.insert(line.clone()) {
+            continue;
+        }
+        out.push_str(&line);
+    }
+    out
 }
 
 /// A padded, non-degenerate range around values.
@@ -108,6 +135,17 @@ fn chart<'a, 'b>(
     x_desc: &str,
     y_desc: &str,
 ) -> Result<Chart<'a, 'b>, Box<dyn std::error::Error>> {
+    chart_with(area, title, x, y, (x_desc, y_desc), 6)
+}
+
+fn chart_with<'a, 'b>(
+    area: &'a Area<'b>,
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+    (x_desc, y_desc): (&str, &str),
+    y_labels: usize,
+) -> Result<Chart<'a, 'b>, Box<dyn std::error::Error>> {
     let mut c = ChartBuilder::on(area)
         .caption(title, (FONT, 14))
         .margin(8)
@@ -119,7 +157,7 @@ fn chart<'a, 'b>(
         .x_desc(x_desc)
         .y_desc(y_desc)
         .x_labels(6)
-        .y_labels(6)
+        .y_labels(y_labels)
         .label_style((FONT, 11))
         .axis_desc_style((FONT, 12))
         .draw()?;
@@ -356,7 +394,7 @@ pub fn environment(run: &RunData) -> Result<Option<Figure>, ReportError> {
 
 fn panel_count(n: usize) -> (u32, u32) {
     let n = n.max(1) as u32;
-    (340 * n, 340)
+    (360 * n, 360)
 }
 
 fn diagram_panel(
@@ -412,17 +450,17 @@ fn diagram_panel(
             4,
             H0.stroke_width(1),
         ))?
-        .label(format!("H0 threshold {:.2}σ", cl.h0_ratio))
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], H0.stroke_width(1)));
+        .label("thresholds (dashed)")
+        .legend(|(x, y)| {
+            DashedPathElement::new(vec![(x, y), (x + 18, y)], 4, 2, BLACK.stroke_width(1))
+        });
         if cl.h1_ratio > 0.0 {
             c.draw_series(DashedLineSeries::new(
                 vec![(0.0, 0.0), (lim / cl.h1_ratio, lim)],
                 6,
                 4,
                 H1.stroke_width(1),
-            ))?
-            .label(format!("H1: death/birth ≥ {:.2}", cl.h1_ratio))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], H1.stroke_width(1)));
+            ))?;
         }
         let s = cl.h1_span * sigma;
         if s < lim {
@@ -431,9 +469,7 @@ fn diagram_panel(
                 2,
                 3,
                 H1.stroke_width(1),
-            ))?
-            .label(format!("H1: death − birth ≥ {:.2}σ", cl.h1_span))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], H1.stroke_width(1)));
+            ))?;
         }
     }
     let pos = |b: &super::data::BarIn| (b.birth, b.death.unwrap_or(inf));
@@ -899,7 +935,7 @@ pub fn global(run: &RunData) -> Result<Figure, ReportError> {
     let panels_n = 1 + usize::from(run.world.is_some());
     let svg = render(&name, (520 * panels_n as u32, 360), |root| {
         let panels = root.split_evenly((1, panels_n));
-        let mut c = chart(
+        let mut c = chart_with(
             &panels[0],
             &format!(
                 "estimated global map: (β0, β1) = ({}, {})",
@@ -907,12 +943,15 @@ pub fn global(run: &RunData) -> Result<Figure, ReportError> {
             ),
             x_range,
             (0.0, height),
-            if by_space {
-                "position along the sweep (m)"
-            } else {
-                "time (s)"
-            },
-            "components (stacked; no unit)",
+            (
+                if by_space {
+                    "position along the sweep (m)"
+                } else {
+                    "time (s)"
+                },
+                "components of each window (stacked)",
+            ),
+            0,
         )?;
         for &(wi, x0, x1, y) in &bars {
             let col = PALETTE[(wi + 1) % 2];
@@ -1002,6 +1041,16 @@ pub fn all(run: &RunData) -> Result<Vec<Figure>, ReportError> {
 mod tests {
     use super::*;
     use crate::report::data::MergeIn;
+
+    #[test]
+    fn compact_drops_defaults_and_repeated_circles_only() {
+        let svg = "<svg>\n<circle cx=\"1\" cy=\"2\" r=\"3\" opacity=\"1\" fill=\"#1F77B4\" stroke=\"none\" stroke-width=\"1\"/>\n<circle cx=\"1\" cy=\"2\" r=\"3\" opacity=\"1\" fill=\"#1F77B4\" stroke=\"none\" stroke-width=\"1\"/>\n<circle cx=\"1\" cy=\"2\" r=\"7\" opacity=\"0.5\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n<polyline points=\"0,0 1,1 \"/>\n<polyline points=\"0,0 1,1 \"/>\n</svg>\n";
+        let c = compact(svg);
+        assert_eq!(
+            c,
+            "<svg>\n<circle cx=\"1\" cy=\"2\" r=\"3\" fill=\"#1F77B4\"/>\n<circle cx=\"1\" cy=\"2\" r=\"7\" opacity=\"0.5\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n<polyline points=\"0,0 1,1 \"/>\n<polyline points=\"0,0 1,1 \"/>\n</svg>\n"
+        );
+    }
 
     #[test]
     fn viridis_ends_and_middle() {
