@@ -7,8 +7,8 @@
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
 use crate::io::write_atomic;
 use crate::log::{EncounterLog, LogError};
-use crate::mapping::local::LocalMap;
 use crate::mapping::classify::Classifier;
+use crate::mapping::local::LocalMap;
 use crate::mapping::output::{
     ConnectionSummary, GlobalSummary, Summary, connection_json, window_json_with,
 };

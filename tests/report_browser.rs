@@ -299,7 +299,10 @@ fn check_page(chrome: &Path, index: &Path, screenshot: &Path, size: (u32, u32)) 
             f["width"].as_f64().unwrap() > 0.0 && f["height"].as_f64().unwrap() > 0.0,
             "figure rendered with zero size: {f}"
         );
-        assert!(f["shapes"].as_u64().unwrap() > 0, "figure draws nothing: {f}");
+        assert!(
+            f["shapes"].as_u64().unwrap() > 0,
+            "figure draws nothing: {f}"
+        );
     }
 
     // The replay: press play, and its time advances.
@@ -349,7 +352,10 @@ fn the_report_page_works_in_headless_chromium() {
     assert!(status.success());
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-tiny.png");
     let n = check_page(&chrome, &run.join("report/index.html"), &shot, (1280, 1000));
-    assert_eq!(n, 8, "tiny: global, environment, 2 × 2 per window, 2 per pair");
+    assert_eq!(
+        n, 8,
+        "tiny: global, environment, 2 × 2 per window, 2 per pair"
+    );
     shout(&format!("report screenshot: {}", shot.display()));
 }
 

@@ -63,10 +63,23 @@ fn report_regenerates_byte_identical_files() {
     assert!(first.iter().all(|(name, _)| !name.ends_with(".tmp")));
     swarmmap().arg("report").arg(&dir).assert().success();
     assert!(first == report_files(&dir), "a second report differs");
-    let html = String::from_utf8(first.iter().find(|f| f.0 == "index.html").unwrap().1.clone())
-        .unwrap();
+    let html = String::from_utf8(
+        first
+            .iter()
+            .find(|f| f.0 == "index.html")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
     // Self-contained: no external scripts, styles, images or fetches.
-    for needle in ["src=\"http", "href=\"http", "<link rel=\"stylesheet", "fetch(", "XMLHttpRequest"] {
+    for needle in [
+        "src=\"http",
+        "href=\"http",
+        "<link rel=\"stylesheet",
+        "fetch(",
+        "XMLHttpRequest",
+    ] {
         assert!(!html.contains(needle), "page references {needle}");
     }
 }
@@ -119,7 +132,8 @@ fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
     // A dendrogram merge that names a cluster not made yet.
     let (_t3, d3) = fixture_copy();
     let path = d3.join("maps/connection_1.json");
-    let mut c: serde_json::Value = serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    let mut c: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
     c["merges"][0]["a"] = serde_json::json!(100_000);
     fs::write(&path, serde_json::to_string(&c).unwrap()).unwrap();
     swarmmap()
@@ -132,8 +146,10 @@ fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
     // A hole cycle that points past the window's events.
     let (_t4, d4) = fixture_copy();
     let path = d4.join("maps/window_1.json");
-    let mut w: serde_json::Value = serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
-    w["components"][0]["holes"] = serde_json::json!([{"birth": 1.0, "death": 2.0, "cycle": [[0, 99999]]}]);
+    let mut w: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    w["components"][0]["holes"] =
+        serde_json::json!([{"birth": 1.0, "death": 2.0, "cycle": [[0, 99999]]}]);
     fs::write(&path, serde_json::to_string(&w).unwrap()).unwrap();
     swarmmap()
         .arg("report")
@@ -143,7 +159,11 @@ fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
         .stderr(contains("window_1.json"));
 
     let (_t5, d5) = fixture_copy();
-    fs::write(d5.join("trajectories.csv"), "time,agent,x,y,state\n0,1,2,3,flying\n").unwrap();
+    fs::write(
+        d5.join("trajectories.csv"),
+        "time,agent,x,y,state\n0,1,2,3,flying\n",
+    )
+    .unwrap();
     swarmmap()
         .arg("report")
         .arg(&d5)
@@ -200,7 +220,10 @@ fn run_writes_the_report_and_trajectories_unless_told_not_to() {
     let meta: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(a.join("meta.json")).unwrap()).unwrap();
     // Default interval: max(1 s, 210 s / 600) = 1 s.
-    assert_eq!(meta["outputs"]["trajectory_interval"], serde_json::json!(1.0));
+    assert_eq!(
+        meta["outputs"]["trajectory_interval"],
+        serde_json::json!(1.0)
+    );
     swarmmap()
         .args(["run", TINY, "--quiet", "--no-report", "--out"])
         .arg(&b)

@@ -31,22 +31,14 @@ fn every_figure_matches_its_snapshot() {
 }
 
 fn json(path: &str) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(Path::new(FIXTURE).join(path)).unwrap())
-        .unwrap()
+    serde_json::from_str(&std::fs::read_to_string(Path::new(FIXTURE).join(path)).unwrap()).unwrap()
 }
 
 #[test]
 fn figures_draw_what_the_map_files_hold() {
     let run = load_run(Path::new(FIXTURE)).unwrap();
     let report = render(&run).unwrap();
-    let svg = |name: &str| {
-        &report
-            .figures
-            .iter()
-            .find(|f| f.name == name)
-            .unwrap()
-            .svg
-    };
+    let svg = |name: &str| &report.figures.iter().find(|f| f.name == name).unwrap().svg;
     for i in 1..=2 {
         // One orange triangle per H1 bar, plus the legend's (triangles are never merged).
         let w = json(&format!("maps/window_{i}.json"));
@@ -77,7 +69,10 @@ fn figures_draw_what_the_map_files_hold() {
                 comp["betti"][0],
                 comp["betti"][1]
             );
-            assert!(svg(&format!("window_{i}_diagram.svg")).contains(&title), "{title}");
+            assert!(
+                svg(&format!("window_{i}_diagram.svg")).contains(&title),
+                "{title}"
+            );
         }
     }
     let c = json("maps/connection_1.json");
@@ -146,7 +141,13 @@ fn decode_replay(html: &str) -> (Vec<f64>, usize, Vec<(f64, f64, u8)>) {
             }
         }
     };
-    let unzig = |v: u64| if v % 2 == 0 { (v / 2) as i64 } else { -(v.div_ceil(2) as i64) };
+    let unzig = |v: u64| {
+        if v.is_multiple_of(2) {
+            (v / 2) as i64
+        } else {
+            -(v.div_ceil(2) as i64)
+        }
+    };
     let mut cur = vec![(0i64, 0i64, 0u8); n];
     let mut frames = Vec::new();
     for _ in &times {
@@ -194,7 +195,11 @@ fn the_replay_decodes_back_to_the_trajectories() {
     };
     for (k, (t, agent, x, y, s)) in rows.iter().enumerate() {
         let f = k / n;
-        assert!((times[f] - t).abs() < 0.006, "frame {f}: {} vs {t}", times[f]);
+        assert!(
+            (times[f] - t).abs() < 0.006,
+            "frame {f}: {} vs {t}",
+            times[f]
+        );
         let (dx, dy, ds) = frames[f * n + agent];
         assert!(
             (dx - x).abs() <= 0.005 + 1e-9 && (dy - y).abs() <= 0.005 + 1e-9,

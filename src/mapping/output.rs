@@ -224,10 +224,18 @@ pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> St
                 .copied()
                 .filter(|d| d.is_finite() && *d < UNREACHABLE)
                 .fold(0.0f64, f64::max);
-            let far = if finite_max > 0.0 { 2.0 * finite_max } else { 1.0 };
+            let far = if finite_max > 0.0 {
+                2.0 * finite_max
+            } else {
+                1.0
+            };
             let display = DistanceMatrix::from_fn(n, |i, j| {
                 let d = metric.get(i, j);
-                if d.is_finite() && d < UNREACHABLE { d } else { far }
+                if d.is_finite() && d < UNREACHABLE {
+                    d
+                } else {
+                    far
+                }
             });
             let xy = match classical_mds(&display, 2) {
                 Ok(e) if e.coords.len() == n => (0..n)

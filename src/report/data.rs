@@ -174,7 +174,7 @@ fn check_window(path: &Path, w: &WindowIn) -> Result<(), ReportError> {
         .events
         .iter()
         .all(|e| e.start.is_finite() && e.point.iter().all(|x| x.is_finite()));
-    if !finite || !(w.start.is_finite() && w.end.is_finite()) {
+    if !(finite && w.start.is_finite() && w.end.is_finite()) {
         return Err(invalid(path, "a time or a point coordinate is not finite"));
     }
     for (c, comp) in w.components.iter().enumerate() {
@@ -188,17 +188,22 @@ fn check_window(path: &Path, w: &WindowIn) -> Result<(), ReportError> {
             if let Some(&(a, b)) = hole.cycle.iter().find(|&&(a, b)| a >= n || b >= n) {
                 return Err(invalid(
                     path,
-                    format!("a hole of component {c} has the edge ({a}, {b}), but the window has {n} events"),
+                    format!(
+                        "a hole of component {c} has the edge ({a}, {b}), but the window has {n} events"
+                    ),
                 ));
             }
         }
-        let bars_ok = comp.diagram.iter().all(|b| {
-            b.birth.is_finite() && b.death.is_none_or(|d| d.is_finite()) && b.dim < 2
-        });
+        let bars_ok = comp
+            .diagram
+            .iter()
+            .all(|b| b.birth.is_finite() && b.death.is_none_or(|d| d.is_finite()) && b.dim < 2);
         if !bars_ok || !comp.scale.is_finite() {
             return Err(invalid(
                 path,
-                format!("component {c} has a bar or scale that is not finite, or of dimension above 1"),
+                format!(
+                    "component {c} has a bar or scale that is not finite, or of dimension above 1"
+                ),
             ));
         }
     }
@@ -210,7 +215,10 @@ fn check_connection(path: &Path, c: &ConnectionIn) -> Result<(), ReportError> {
     if c.merges.len() >= n.max(1) {
         return Err(invalid(
             path,
-            format!("{} merges for {n} points; a dendrogram has at most n − 1", c.merges.len()),
+            format!(
+                "{} merges for {n} points; a dendrogram has at most n − 1",
+                c.merges.len()
+            ),
         ));
     }
     for (k, m) in c.merges.iter().enumerate() {
@@ -218,7 +226,10 @@ fn check_connection(path: &Path, c: &ConnectionIn) -> Result<(), ReportError> {
         if m.a >= n + k || m.b >= n + k || m.a == m.b {
             return Err(invalid(
                 path,
-                format!("merge {k} joins clusters {} and {}, which do not exist yet", m.a, m.b),
+                format!(
+                    "merge {k} joins clusters {} and {}, which do not exist yet",
+                    m.a, m.b
+                ),
             ));
         }
         if m.height.is_some_and(|h| !h.is_finite()) {
@@ -232,7 +243,10 @@ fn check_connection(path: &Path, c: &ConnectionIn) -> Result<(), ReportError> {
                 && p.truth.is_none_or(|t| t.iter().all(|x| x.is_finite()))
         });
     if !finite {
-        return Err(invalid(path, "a coordinate, a time or the cut-off is not finite"));
+        return Err(invalid(
+            path,
+            "a coordinate, a time or the cut-off is not finite",
+        ));
     }
     Ok(())
 }
@@ -277,14 +291,21 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
                 .ok_or_else(|| {
                     invalid(
                         path,
-                        format!("line {line}: column `{}` is `{}`, not a finite number", expected[i], field(i)),
+                        format!(
+                            "line {line}: column `{}` is `{}`, not a finite number",
+                            expected[i],
+                            field(i)
+                        ),
                     )
                 })
         };
         let agent: u32 = field(1).parse().map_err(|_| {
             invalid(
                 path,
-                format!("line {line}: column `agent` is `{}`, not an agent id", field(1)),
+                format!(
+                    "line {line}: column `agent` is `{}`, not an agent id",
+                    field(1)
+                ),
             )
         })?;
         let state = match field(4) {

@@ -59,7 +59,11 @@ pub fn viridis(f: f64) -> RGBColor {
         (94, 201, 98),
         (253, 231, 37),
     ];
-    let f = if f.is_finite() { f.clamp(0.0, 1.0) } else { 0.0 };
+    let f = if f.is_finite() {
+        f.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let x = f * 4.0;
     let i = (x.floor() as usize).min(3);
     let t = x - i as f64;
@@ -340,7 +344,10 @@ pub fn environment(run: &RunData) -> Result<Option<Figure>, ReportError> {
         draw_arena(&mut c, world, OBSTACLE)?;
         let y_leader = 1.15 * h;
         c.draw_series(DashedLineSeries::new(
-            vec![(world.leader.start_x, y_leader), (world.leader.end_x, y_leader)],
+            vec![
+                (world.leader.start_x, y_leader),
+                (world.leader.end_x, y_leader),
+            ],
             6,
             4,
             BLACK.stroke_width(2),
@@ -397,12 +404,7 @@ fn panel_count(n: usize) -> (u32, u32) {
     (360 * n, 360)
 }
 
-fn diagram_panel(
-    area: &Area<'_>,
-    w: &WindowIn,
-    ci: usize,
-    comp: &ComponentIn,
-) -> DrawResult {
+fn diagram_panel(area: &Area<'_>, w: &WindowIn, ci: usize, comp: &ComponentIn) -> DrawResult {
     let sigma = comp.scale;
     let mut top = comp
         .diagram
@@ -426,7 +428,14 @@ fn diagram_panel(
         comp.betti[1],
         sigma
     );
-    let mut c = chart(area, &title, (0.0, lim), (0.0, lim), "birth (s)", "death (s)")?;
+    let mut c = chart(
+        area,
+        &title,
+        (0.0, lim),
+        (0.0, lim),
+        "birth (s)",
+        "death (s)",
+    )?;
     c.draw_series(std::iter::once(PathElement::new(
         vec![(0.0, 0.0), (lim, lim)],
         BLACK.mix(0.5).stroke_width(1),
@@ -557,7 +566,10 @@ fn time_colour(t: f64, (t0, t1): (f64, f64)) -> RGBColor {
     viridis(if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 })
 }
 
-fn cycles_of<'w>(w: &'w WindowIn, comp: Option<usize>) -> impl Iterator<Item = (usize, usize)> + 'w {
+fn cycles_of<'w>(
+    w: &'w WindowIn,
+    comp: Option<usize>,
+) -> impl Iterator<Item = (usize, usize)> + 'w {
     w.components
         .iter()
         .enumerate()
@@ -574,78 +586,78 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
     let truth = truth.filter(|t| !t.is_empty());
     let panels_n = w.components.len() + usize::from(truth.is_some());
     let times = (w.start, w.end);
-    let svg = render(&name, panel_count(panels_n), |root| {
-        if panels_n == 0 {
-            return empty_panel(root, &format!("W{}", w.index), "no real component");
-        }
-        let panels = root.split_evenly((1, panels_n));
-        for (ci, comp) in w.components.iter().enumerate() {
-            let pts: Vec<(f64, f64)> = comp
-                .events
-                .iter()
-                .map(|&j| (w.events[j].point[0], w.events[j].point[1]))
-                .collect();
-            let mut c = chart(
-                &panels[ci],
-                &format!("W{} component {}: embedding", w.index, ci + 1),
-                span(pts.iter().map(|p| p.0)),
-                span(pts.iter().map(|p| p.1)),
-                "MDS coordinate 1 (s)",
-                "MDS coordinate 2 (s)",
-            )?;
-            c.draw_series(comp.events.iter().zip(&pts).map(|(&j, &p)| {
-                Circle::new(p, 2, time_colour(w.events[j].start, times).filled())
-            }))?;
-            let at = |j: usize| (w.events[j].point[0], w.events[j].point[1]);
-            c.draw_series(
-                cycles_of(w, Some(ci))
-                    .map(|(a, b)| PathElement::new(vec![at(a), at(b)], BLACK.stroke_width(2))),
-            )?;
-        }
-        if let Some(truth) = &truth {
-            let domain = run
-                .summary
-                .windows
-                .iter()
-                .find(|s| s.index == w.index)
-                .and_then(|s| s.domain);
-            let x = domain.map_or_else(|| span(truth.iter().map(|p| p.0)), |d| (d[0], d[1]));
-            let y = run.world.as_ref().map_or_else(
-                || span(truth.iter().map(|p| p.1)),
-                |wd| (0.0, wd.arena.height),
-            );
-            let mut c = chart(
-                &panels[panels_n - 1],
-                &format!("W{}: the same events at their true positions", w.index),
-                x,
-                y,
-                "x (m)",
-                "y (m)",
-            )?;
-            if let Some(world) = &run.world {
-                for o in &world.obstacles {
-                    c.draw_series(
-                        obstacle_polygons(o)
-                            .into_iter()
-                            .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
-                    )?;
-                }
+    let svg =
+        render(&name, panel_count(panels_n), |root| {
+            if panels_n == 0 {
+                return empty_panel(root, &format!("W{}", w.index), "no real component");
             }
-            c.draw_series(w.events.iter().zip(truth).map(|(e, &p)| {
-                let col = if e.noise {
-                    NOISE
-                } else {
-                    time_colour(e.start, times)
-                };
-                Circle::new(p, 2, col.filled())
-            }))?;
-            c.draw_series(
-                cycles_of(w, None)
-                    .map(|(a, b)| PathElement::new(vec![truth[a], truth[b]], BLACK.stroke_width(2))),
-            )?;
-        }
-        Ok(())
-    })?;
+            let panels = root.split_evenly((1, panels_n));
+            for (ci, comp) in w.components.iter().enumerate() {
+                let pts: Vec<(f64, f64)> = comp
+                    .events
+                    .iter()
+                    .map(|&j| (w.events[j].point[0], w.events[j].point[1]))
+                    .collect();
+                let mut c = chart(
+                    &panels[ci],
+                    &format!("W{} component {}: embedding", w.index, ci + 1),
+                    span(pts.iter().map(|p| p.0)),
+                    span(pts.iter().map(|p| p.1)),
+                    "MDS coordinate 1 (s)",
+                    "MDS coordinate 2 (s)",
+                )?;
+                c.draw_series(comp.events.iter().zip(&pts).map(|(&j, &p)| {
+                    Circle::new(p, 2, time_colour(w.events[j].start, times).filled())
+                }))?;
+                let at = |j: usize| (w.events[j].point[0], w.events[j].point[1]);
+                c.draw_series(
+                    cycles_of(w, Some(ci))
+                        .map(|(a, b)| PathElement::new(vec![at(a), at(b)], BLACK.stroke_width(2))),
+                )?;
+            }
+            if let Some(truth) = &truth {
+                let domain = run
+                    .summary
+                    .windows
+                    .iter()
+                    .find(|s| s.index == w.index)
+                    .and_then(|s| s.domain);
+                let x = domain.map_or_else(|| span(truth.iter().map(|p| p.0)), |d| (d[0], d[1]));
+                let y = run.world.as_ref().map_or_else(
+                    || span(truth.iter().map(|p| p.1)),
+                    |wd| (0.0, wd.arena.height),
+                );
+                let mut c = chart(
+                    &panels[panels_n - 1],
+                    &format!("W{}: the same events at their true positions", w.index),
+                    x,
+                    y,
+                    "x (m)",
+                    "y (m)",
+                )?;
+                if let Some(world) = &run.world {
+                    for o in &world.obstacles {
+                        c.draw_series(
+                            obstacle_polygons(o)
+                                .into_iter()
+                                .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
+                        )?;
+                    }
+                }
+                c.draw_series(w.events.iter().zip(truth).map(|(e, &p)| {
+                    let col = if e.noise {
+                        NOISE
+                    } else {
+                        time_colour(e.start, times)
+                    };
+                    Circle::new(p, 2, col.filled())
+                }))?;
+                c.draw_series(cycles_of(w, None).map(|(a, b)| {
+                    PathElement::new(vec![truth[a], truth[b]], BLACK.stroke_width(2))
+                }))?;
+            }
+            Ok(())
+        })?;
     Ok(Figure {
         name,
         title: format!("W{}: encounter point cloud", w.index),
@@ -682,7 +694,10 @@ pub fn pair_cloud(run: &RunData, conn: &ConnectionIn) -> Result<Figure, ReportEr
         let pts: Vec<(f64, f64)> = conn.points.iter().map(|p| (p.xy[0], p.xy[1])).collect();
         let mut c = chart(
             &panels[0],
-            &format!("M{i}–M{j}: {} cluster(s), c = {} s", conn.count, conn.cutoff),
+            &format!(
+                "M{i}–M{j}: {} cluster(s), c = {} s",
+                conn.count, conn.cutoff
+            ),
             span(pts.iter().map(|p| p.0)),
             span(pts.iter().map(|p| p.1)),
             "MDS coordinate 1 (s)",
@@ -796,7 +811,10 @@ pub fn dendrogram(conn: &ConnectionIn) -> Result<Figure, ReportError> {
     let svg = render(&name, (width, 340), |root| {
         let mut c = chart(
             root,
-            &format!("M{i}–M{j}: single linkage, {} cluster(s) below c", conn.count),
+            &format!(
+                "M{i}–M{j}: single linkage, {} cluster(s) below c",
+                conn.count
+            ),
             (-1.0, n.max(1) as f64),
             (0.0, 1.22 * top),
             "points of the inter-domain cloud (leaf order)",
@@ -805,7 +823,12 @@ pub fn dendrogram(conn: &ConnectionIn) -> Result<Figure, ReportError> {
         c.draw_series(conn.merges.iter().enumerate().map(|(k, m)| {
             let h = y[n + k];
             PathElement::new(
-                vec![(xs[m.a], y[m.a]), (xs[m.a], h), (xs[m.b], h), (xs[m.b], y[m.b])],
+                vec![
+                    (xs[m.a], y[m.a]),
+                    (xs[m.a], h),
+                    (xs[m.b], h),
+                    (xs[m.b], y[m.b]),
+                ],
                 BLACK.stroke_width(1),
             )
         }))?;
@@ -861,7 +884,11 @@ pub fn leader_x(track: &[(f64, f64)], t: f64) -> Option<f64> {
     }
     let k = track.partition_point(|p| p.0 <= t);
     let (a, b) = (track[k - 1], track[k]);
-    let f = if b.0 > a.0 { (t - a.0) / (b.0 - a.0) } else { 0.0 };
+    let f = if b.0 > a.0 {
+        (t - a.0) / (b.0 - a.0)
+    } else {
+        0.0
+    };
     Some(a.1 + f * (b.1 - a.1))
 }
 
@@ -924,7 +951,13 @@ pub fn global(run: &RunData) -> Result<Figure, ReportError> {
     }
     let x_range = if by_space {
         let w = run.world.as_ref().map_or_else(
-            || s.windows.iter().filter_map(|w| w.domain).map(|d| d[1]).fold(0.0, f64::max),
+            || {
+                s.windows
+                    .iter()
+                    .filter_map(|w| w.domain)
+                    .map(|d| d[1])
+                    .fold(0.0, f64::max)
+            },
             |w| w.arena.width,
         );
         (-0.02 * w, 1.02 * w)
@@ -992,7 +1025,11 @@ pub fn global(run: &RunData) -> Result<Figure, ReportError> {
                 (FONT, 10),
             )
         }))?;
-        c.draw_series(holes.iter().map(|&p| Circle::new(p, 9, LANDMARK.stroke_width(3))))?;
+        c.draw_series(
+            holes
+                .iter()
+                .map(|&p| Circle::new(p, 9, LANDMARK.stroke_width(3))),
+        )?;
         if let Some(world) = &run.world {
             let mut c = chart(
                 &panels[1],

@@ -340,7 +340,7 @@ pub fn page(run: &RunData, figures: &[Figure], replay: Option<&Replay>) -> Strin
     }
     h.push_str("</section>\n");
     if replay.is_some() {
-        let _ = write!(h, "<script>{SCRIPT}</script>\n");
+        let _ = writeln!(h, "<script>{SCRIPT}</script>");
     }
     h.push_str("</body>\n</html>\n");
     h
