@@ -280,7 +280,15 @@ fn base64_decode(s: &str) -> Vec<u8> {
 }
 
 /// Loads a report page, runs every check and saves a screenshot; returns the figure count.
-fn check_page(chrome: &Path, index: &Path, screenshot: &Path, size: (u32, u32)) -> usize {
+/// With `poster`, the screenshot shows the top of the page with the replay paused halfway
+/// (the README's picture); else the page as it is after pressing play.
+fn check_page(
+    chrome: &Path,
+    index: &Path,
+    screenshot: &Path,
+    size: (u32, u32),
+    poster: bool,
+) -> usize {
     let tmp = tempfile::tempdir().unwrap();
     let log = tmp.path().join("chromium.log");
     let mut b = Browser::launch(chrome, &tmp.path().join("profile"), &log);
@@ -316,6 +324,11 @@ fn check_page(chrome: &Path, index: &Path, screenshot: &Path, size: (u32, u32)) 
         "the replay's time did not advance after pressing play: {after}"
     );
     assert_ne!(after["text"], json!("t = 0 s"), "{after}");
+    if poster {
+        b.click("#replay-play");
+        b.eval("(() => { const s = document.getElementById('replay-slider'); s.value = String(Math.round(Number(s.max) * 0.55)); s.dispatchEvent(new Event('input')); window.scrollTo(0, 0); return true; })()");
+        std::thread::sleep(Duration::from_millis(300));
+    }
     b.screenshot(screenshot);
 
     let errors = b.errors();
@@ -351,7 +364,13 @@ fn the_report_page_works_in_headless_chromium() {
         .unwrap();
     assert!(status.success());
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-tiny.png");
-    let n = check_page(&chrome, &run.join("report/index.html"), &shot, (1280, 1000));
+    let n = check_page(
+        &chrome,
+        &run.join("report/index.html"),
+        &shot,
+        (1280, 1000),
+        false,
+    );
     assert_eq!(
         n, 8,
         "tiny: global, environment, 2 × 2 per window, 2 per pair"
@@ -368,5 +387,5 @@ fn screenshot_of_a_report() {
     let chrome = find_chromium().expect("chromium");
     let index = PathBuf::from(std::env::var_os("SWARMMAP_REPORT").expect("SWARMMAP_REPORT"));
     let out = PathBuf::from(std::env::var_os("SWARMMAP_SCREENSHOT").expect("SWARMMAP_SCREENSHOT"));
-    check_page(&chrome, &index, &out, (1280, 1600));
+    check_page(&chrome, &index, &out, (1280, 1450), true);
 }

@@ -314,12 +314,13 @@ pub fn environment(run: &RunData) -> Result<Option<Figure>, ReportError> {
         .iter()
         .filter_map(|s| s.domain.map(|d| (s.index, d)))
         .collect();
-    let svg = render("environment", arena_size(world, 960, 1.22), |root| {
+    let svg = render("environment", arena_size(world, 960, 1.42), |root| {
         let mut c = chart(
             root,
             &format!("{}: environment, landmarks and domains", world.name),
             (-0.02 * w, 1.02 * w),
-            (-0.02 * h, 1.2 * h),
+            // Room above the arena for the domains and the leader, below it for the legend.
+            (-0.22 * h, 1.2 * h),
             "x (m)",
             "y (m)",
         )?;
@@ -382,7 +383,13 @@ pub fn environment(run: &RunData) -> Result<Option<Figure>, ReportError> {
         )?
         .label("initial positions")
         .legend(|(x, y)| Circle::new((x + 8, y), 3, BLACK.stroke_width(1)));
-        legend(&mut c)
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .label_font((FONT, 11))
+            .draw()?;
+        Ok(())
     })?;
     let replay_note = if run.trajectories.is_some() {
         "initial positions and landmarks from trajectories.csv"
