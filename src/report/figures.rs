@@ -244,9 +244,11 @@ fn arena_size(world: &World, width: u32, y_extra: f64) -> (u32, u32) {
     (width, h as u32)
 }
 
-/// Landmark positions over the whole run, metres: from `trajectories.csv` when recorded
-/// (every distinct position an agent held as a landmark), else from the encounters of
-/// landmark agents during their static intervals (truth columns).
+/// Landmark positions over the whole run, metres: every distinct position an agent held as
+/// a landmark in `trajectories.csv` (when recorded), together with, for each landmark static
+/// interval of the log, the true position of the agent at its first encounter in that
+/// interval (truth columns; catches landmarks shorter than the trajectory interval).
+/// O(samples + intervals · k) for k encounters per agent.
 pub fn landmark_positions(run: &RunData) -> Vec<(f64, f64)> {
     let mut out = Vec::new();
     if let Some(traj) = &run.trajectories {
@@ -261,7 +263,14 @@ pub fn landmark_positions(run: &RunData) -> Vec<(f64, f64)> {
                 last.insert(s.agent, p);
             }
         }
-        return out;
+    }
+    // Encounters by agent, in log order (sorted by start).
+    let mut by_agent: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    for (k, e) in run.log.encounters.iter().enumerate() {
+        if e.truth.is_some() {
+            by_agent.entry(e.a).or_default().push(k);
+            by_agent.entry(e.b).or_default().push(k);
+        }
     }
     for iv in run
         .log
@@ -269,17 +278,18 @@ pub fn landmark_positions(run: &RunData) -> Vec<(f64, f64)> {
         .iter()
         .filter(|s| s.reason == crate::log::StaticReason::Landmark)
     {
-        let hit = run.log.encounters.iter().find_map(|e| {
+        let Some(list) = by_agent.get(&iv.agent) else {
+            continue;
+        };
+        let hit = list.iter().find_map(|&k| {
+            let e = &run.log.encounters[k];
             let t = e.truth?;
-            let within = e.start <= iv.end && iv.start <= e.end;
-            if !within {
+            if e.start > iv.end || e.end < iv.start {
                 None
             } else if e.a == iv.agent {
                 Some((t[0], t[1]))
-            } else if e.b == iv.agent {
-                Some((t[2], t[3]))
             } else {
-                None
+                Some((t[2], t[3]))
             }
         });
         out.extend(hit);
@@ -392,9 +402,9 @@ pub fn environment(run: &RunData) -> Result<Option<Figure>, ReportError> {
         Ok(())
     })?;
     let replay_note = if run.trajectories.is_some() {
-        "initial positions and landmarks from trajectories.csv"
+        "initial positions from trajectories.csv; landmark positions from trajectories.csv and from the landmarks' encounters (truth columns)"
     } else {
-        "no trajectories.csv: landmark positions from the encounters' truth columns, initial positions unknown"
+        "no trajectories.csv: landmark positions from the landmarks' encounters (truth columns), initial positions unknown"
     };
     Ok(Some(Figure {
         name: "environment.svg".into(),
