@@ -12,12 +12,14 @@
 //! | world | [`world`] | RON text | [`world::World`] |
 //! | simulation | [`sim`] | [`world::World`], seed | [`log::EncounterLog`] |
 //! | topology engine | [`topology`] | point clouds, distance matrices | diagrams, dendrograms, embeddings |
+//! | report | [`report`] | a run directory | SVG figures and a self-contained `index.html` |
 
 pub mod eval;
 pub mod io;
 pub mod log;
 pub mod mapping;
 pub mod pipeline;
+pub mod report;
 pub mod sim;
 pub mod topology;
 pub mod world;

@@ -7,8 +7,11 @@
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
 use crate::io::write_atomic;
 use crate::log::{EncounterLog, LogError};
+use crate::mapping::classify::Classifier;
 use crate::mapping::local::LocalMap;
-use crate::mapping::output::{ConnectionSummary, GlobalSummary, Summary, window_json};
+use crate::mapping::output::{
+    ConnectionSummary, GlobalSummary, Summary, connection_json, window_json_with,
+};
 use crate::mapping::pipeline::{MapConfig, map_windows, summarise};
 use crate::mapping::stitch::{Connection, GlobalMap, StitchParams, connect, global_map};
 use crate::sim::{SimError, SimOptions, SimOutput, simulate, write_run};
@@ -54,6 +57,10 @@ pub struct Mapped {
     pub connections: Vec<Connection>,
     pub global: GlobalMap,
     pub summary: Summary,
+    /// The classifier the diagrams were judged with (recorded in `maps/window_<i>.json`).
+    pub classifier: Classifier,
+    /// The stitching parameters (the cut-off is recorded in `maps/connection_<i>.json`).
+    pub stitch: StitchParams,
 }
 
 /// Wall-clock seconds per stage, in the order the stages ran.
@@ -152,10 +159,13 @@ pub fn map_log(
         connections,
         global,
         summary,
+        classifier: cfg.local.classifier,
+        stitch: *stitch,
     })
 }
 
-/// Writes `maps/window_<i>.json`, `maps/connections.json`, `maps/global.json` and
+/// Writes `maps/window_<i>.json`, `maps/connections.json`, `maps/connection_<i>.json` (one
+/// per consecutive pair, named after its first window), `maps/global.json` and
 /// `summary.json` into `dir`, each atomically.
 pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), PipelineError> {
     let write = |name: String, text: String| {
@@ -165,7 +175,13 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     for (map, s) in m.maps.iter().zip(&m.summary.windows) {
         write(
             format!("maps/window_{}.json", map.index),
-            window_json(map, log, s.truth),
+            window_json_with(map, log, s.truth, &m.classifier),
+        )?;
+    }
+    for c in &m.connections {
+        write(
+            format!("maps/connection_{}.json", c.between[0]),
+            connection_json(c, log, m.stitch.cutoff),
         )?;
     }
     write("maps/connections.json".into(), to_json(&m.connections))?;

@@ -6,6 +6,7 @@ mod check;
 mod eval;
 mod map;
 mod persistence;
+mod report;
 mod run;
 mod simulate;
 
@@ -85,6 +86,8 @@ enum Command {
     Calibrate(calibrate::CalibrateArgs),
     /// Vietoris–Rips persistence diagram (H0, H1) of a CSV of points or distances.
     Persistence(persistence::PersistenceArgs),
+    /// Write the report of a run (SVG figures and a self-contained index.html) into RUN_DIR/report/.
+    Report(report::ReportArgs),
 }
 
 pub fn main() -> ExitCode {
@@ -100,6 +103,7 @@ pub fn main() -> ExitCode {
         Command::Eval(args) => eval::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Persistence(a) => persistence::run(a),
+        Command::Report(args) => report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

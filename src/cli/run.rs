@@ -1,5 +1,5 @@
 //! `swarmmap run WORLD [--seed N] [--out DIR]`: simulate, map, stitch and evaluate in one
-//! command, and print the compact accuracy table.
+//! command, print the compact accuracy table, and write the report (`DIR/report/`).
 
 use super::{Failure, input, load_world, progress_bar};
 use clap::Args;
@@ -20,9 +20,13 @@ pub struct RunArgs {
     /// Override a world field, e.g. `--set swarm.detection_radius=0.03` (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     pub set: Vec<String>,
-    /// Also write trajectories.csv every INTERVAL seconds (default interval: 1 s).
+    /// Write trajectories.csv every INTERVAL seconds (always written, for the report's
+    /// replay; default interval: max(1 s, run duration / 600); the flag without a value: 1 s).
     #[arg(long, value_name = "INTERVAL", num_args = 0..=1, default_missing_value = "1.0")]
     pub trajectories: Option<f64>,
+    /// Do not write the report (DIR/report/); `swarmmap report DIR` writes it later.
+    #[arg(long)]
+    pub no_report: bool,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -44,7 +48,10 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let opts = RunOptions {
         seed,
         out: Some(out.clone()),
-        trajectories: args.trajectories,
+        trajectories: Some(
+            args.trajectories
+                .unwrap_or_else(|| swarmmap::report::default_trajectory_interval(&world)),
+        ),
         progress: Some(&report),
     };
     let result = run_world(&world, &opts);
@@ -60,5 +67,9 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     })?;
     print!("{}", mapped.summary.table());
     println!("outputs: {}", out.display());
+    if !args.no_report {
+        let written = swarmmap::report::write_report(&out).map_err(super::report::failure)?;
+        println!("{}", super::report::describe(&written));
+    }
     Ok(())
 }

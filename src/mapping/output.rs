@@ -1,13 +1,20 @@
-//! What `swarmmap map` writes: `maps/window_<i>.json` per window and `summary.json`
-//! (documented column by column in the README, "Output files").
+//! What `swarmmap map` writes: `maps/window_<i>.json` per window, `maps/connection_<i>.json`
+//! per consecutive pair and `summary.json` (documented column by column in the README,
+//! "Output files"). The report (`crate::report`) reads only these files.
 
+use super::classify::Classifier;
 use super::local::LocalMap;
+use super::pipeline::true_position;
+use super::stitch::Connection;
 use crate::log::EncounterLog;
-use serde::Serialize;
+use crate::topology::DistanceMatrix;
+use crate::topology::linkage::single_linkage;
+use crate::topology::mds::classical_mds;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// Geometric fidelity of one window against the log's truth columns.
-#[derive(Debug, Clone, Copy, Default, Serialize)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 pub struct Fidelity {
     /// Spearman rank correlation between the encounter metric and true distances over
     /// the (representative, event) pairs of the window.
@@ -25,7 +32,7 @@ pub struct Fidelity {
 }
 
 /// One window's line in `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct WindowSummary {
     pub index: usize,
     pub start: f64,
@@ -39,7 +46,7 @@ pub struct WindowSummary {
 }
 
 /// The connections between two consecutive windows in `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ConnectionSummary {
     /// 1-based indices of the two windows.
     pub between: [usize; 2],
@@ -50,7 +57,7 @@ pub struct ConnectionSummary {
 }
 
 /// The global map's Betti numbers in `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct GlobalSummary {
     pub betti: [usize; 2],
     pub truth: Option<[usize; 2]>,
@@ -59,7 +66,7 @@ pub struct GlobalSummary {
 }
 
 /// `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
     pub world: String,
     pub seed: Option<u64>,
@@ -73,6 +80,8 @@ pub struct Summary {
 /// An event of a window as written in `window_<i>.json`.
 #[derive(Debug, Clone, Serialize)]
 struct EventOut {
+    /// Index of the encounter in `encounters.csv` order.
+    encounter: usize,
     start: f64,
     end: f64,
     a: u32,
@@ -91,12 +100,35 @@ struct WindowOut<'a> {
     betti: [usize; 2],
     truth: Option<[usize; 2]>,
     explained: f64,
+    /// The classifier's thresholds the diagrams were judged with (see `classify.rs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    classifier: Option<Classifier>,
     events: Vec<EventOut>,
     components: &'a [super::local::Component],
 }
 
 /// The JSON text of `maps/window_<i>.json`.
 pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>) -> String {
+    window_json_impl(map, log, truth, None)
+}
+
+/// The JSON text of `maps/window_<i>.json` with the classifier's thresholds recorded (what
+/// [`crate::pipeline::write_maps`] writes, so that the report can draw them).
+pub fn window_json_with(
+    map: &LocalMap,
+    log: &EncounterLog,
+    truth: Option<[usize; 2]>,
+    classifier: &Classifier,
+) -> String {
+    window_json_impl(map, log, truth, Some(*classifier))
+}
+
+fn window_json_impl(
+    map: &LocalMap,
+    log: &EncounterLog,
+    truth: Option<[usize; 2]>,
+    classifier: Option<Classifier>,
+) -> String {
     let events = map
         .events
         .iter()
@@ -105,6 +137,7 @@ pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>
         .map(|((&i, p), &noise)| {
             let e = &log.encounters[i];
             EventOut {
+                encounter: i,
                 start: e.start,
                 end: e.end,
                 a: e.a,
@@ -121,10 +154,142 @@ pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>
         betti: map.betti,
         truth,
         explained: map.explained,
+        classifier,
         events,
         components: &map.components,
     };
     serde_json::to_string_pretty(&out).expect("window maps serialise")
+}
+
+/// A point of an inter-domain cloud in `connection_<i>.json`.
+#[derive(Serialize)]
+struct CloudPointOut {
+    /// Index of the encounter in `encounters.csv` order.
+    encounter: usize,
+    start: f64,
+    a: u32,
+    b: u32,
+    /// Cluster label (one cluster per connection).
+    label: usize,
+    /// 2-D classical MDS of the correspondence metric, seconds (for drawing only).
+    xy: [f64; 2],
+    /// True position (midpoint of the two agents at `start`), metres, when the log has it.
+    truth: Option<[f64; 2]>,
+}
+
+/// A single-linkage merge in `connection_<i>.json`, in SciPy linkage-matrix form.
+#[derive(Serialize)]
+struct MergeOut {
+    a: usize,
+    b: usize,
+    /// Merge height, seconds; `null` when the two clusters are not connected in the
+    /// encounter graph of W_i ∪ W_{i+1} (they never merge below any cut-off).
+    height: Option<f64>,
+    size: usize,
+}
+
+#[derive(Serialize)]
+struct ConnectionOut<'a> {
+    between: [usize; 2],
+    /// The single-linkage cut-off c, seconds.
+    cutoff: f64,
+    count: usize,
+    static_agents: &'a [u32],
+    joins: &'a [(usize, usize)],
+    points: Vec<CloudPointOut>,
+    merges: Vec<MergeOut>,
+}
+
+/// Distances at or above this are "not connected" (the stitcher stores `f64::MAX` for them).
+const UNREACHABLE: f64 = f64::MAX / 2.0;
+
+/// The JSON text of `maps/connection_<i>.json`: the inter-domain cloud of one pair of
+/// windows with its cluster labels, a 2-D projection for drawing and its single-linkage
+/// merges (for the dendrogram), and the cut-off `cutoff` (seconds) it was cut at.
+///
+/// The projection is classical MDS of the cloud's correspondence metric, with unreachable
+/// pairs set to twice the largest finite distance (so separate parts stay apart); it costs
+/// O(n²) for the n points of the cloud (a few static agents × (k + 1)).
+pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> String {
+    let n = conn.points.len();
+    let (merges, xy) = match &conn.metric {
+        Some(metric) if metric.len() == n && n > 0 => {
+            let dendrogram = single_linkage(metric);
+            let merges = dendrogram
+                .merges
+                .iter()
+                .map(|m| MergeOut {
+                    a: m.a,
+                    b: m.b,
+                    height: (m.height.is_finite() && m.height < UNREACHABLE).then_some(m.height),
+                    size: m.size,
+                })
+                .collect();
+            let finite_max = metric
+                .condensed()
+                .iter()
+                .copied()
+                .filter(|d| d.is_finite() && *d < UNREACHABLE)
+                .fold(0.0f64, f64::max);
+            let far = if finite_max > 0.0 {
+                2.0 * finite_max
+            } else {
+                1.0
+            };
+            let display = DistanceMatrix::from_fn(n, |i, j| {
+                let d = metric.get(i, j);
+                if d.is_finite() && d < UNREACHABLE {
+                    d
+                } else {
+                    far
+                }
+            });
+            let xy = match classical_mds(&display, 2) {
+                Ok(e) if e.coords.len() == n => (0..n)
+                    .map(|i| {
+                        let p = e.coords.point(i);
+                        [
+                            p.first().copied().unwrap_or(0.0),
+                            p.get(1).copied().unwrap_or(0.0),
+                        ]
+                    })
+                    .collect(),
+                _ => vec![[0.0; 2]; n],
+            };
+            (merges, xy)
+        }
+        _ => (Vec::new(), vec![[0.0; 2]; n]),
+    };
+    let points = conn
+        .points
+        .iter()
+        .zip(&conn.labels)
+        .zip(xy)
+        .map(|((&i, &label), xy)| {
+            let e = &log.encounters[i];
+            CloudPointOut {
+                encounter: i,
+                start: e.start,
+                a: e.a,
+                b: e.b,
+                label,
+                xy,
+                truth: e.truth.as_ref().map(true_position),
+            }
+        })
+        .collect();
+    let out = ConnectionOut {
+        between: conn.between,
+        cutoff,
+        count: conn.count,
+        static_agents: &conn.static_agents,
+        joins: &conn.joins,
+        points,
+        merges,
+    };
+    let mut s = serde_json::to_string_pretty(&out).expect("connections serialise");
+    s.push('\n');
+    s
 }
 
 fn betti_cell(b: [usize; 2], t: Option<[usize; 2]>) -> String {

@@ -1,0 +1,403 @@
+//! Reading a run directory for the report: only files on disk (`summary.json`,
+//! `maps/*.json`, the log's CSV files, `meta.json`, `trajectories.csv`), each checked so
+//! that a bad file gives an error naming it rather than a panic or a wrong figure.
+
+use super::ReportError;
+use crate::log::EncounterLog;
+use crate::mapping::classify::Classifier;
+use crate::mapping::output::Summary;
+use crate::pipeline::world_from_run;
+use crate::world::World;
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use std::path::{Path, PathBuf};
+
+/// An event of a window as read from `maps/window_<i>.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct EventIn {
+    /// Index into `encounters.csv` (absent in maps written before the report existed).
+    #[serde(default)]
+    pub encounter: Option<usize>,
+    /// Start time, seconds.
+    pub start: f64,
+    /// 3-D encounter point cloud coordinates, seconds.
+    pub point: [f64; 3],
+    pub noise: bool,
+}
+
+/// A bar of a component's diagram (death `None` = essential), seconds.
+#[derive(Debug, Clone, Deserialize)]
+pub struct BarIn {
+    pub dim: usize,
+    pub birth: f64,
+    pub death: Option<f64>,
+    pub robust: bool,
+}
+
+/// A robust hole and its representative cycle (pairs of indices into the window's events).
+#[derive(Debug, Clone, Deserialize)]
+pub struct HoleIn {
+    pub birth: f64,
+    pub death: f64,
+    pub cycle: Vec<(usize, usize)>,
+}
+
+/// A real component of a window.
+#[derive(Debug, Clone, Deserialize)]
+pub struct ComponentIn {
+    /// Indices into the window's events.
+    pub events: Vec<usize>,
+    /// Sampling scale σ of the diagram, seconds.
+    pub scale: f64,
+    pub diagram: Vec<BarIn>,
+    pub betti: [usize; 2],
+    pub holes: Vec<HoleIn>,
+}
+
+/// `maps/window_<i>.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct WindowIn {
+    pub index: usize,
+    /// Time span, seconds.
+    pub start: f64,
+    pub end: f64,
+    pub betti: [usize; 2],
+    pub truth: Option<[usize; 2]>,
+    /// The classifier's thresholds (absent in maps written before the report existed).
+    #[serde(default)]
+    pub classifier: Option<Classifier>,
+    pub events: Vec<EventIn>,
+    pub components: Vec<ComponentIn>,
+}
+
+/// A point of an inter-domain cloud.
+#[derive(Debug, Clone, Deserialize)]
+pub struct CloudPointIn {
+    pub start: f64,
+    pub label: usize,
+    /// 2-D projection of the correspondence metric, seconds.
+    pub xy: [f64; 2],
+    /// True position, metres.
+    pub truth: Option<[f64; 2]>,
+}
+
+/// A single-linkage merge; `height` `None` = never (not connected).
+#[derive(Debug, Clone, Copy, Deserialize)]
+pub struct MergeIn {
+    pub a: usize,
+    pub b: usize,
+    pub height: Option<f64>,
+    pub size: usize,
+}
+
+/// `maps/connection_<i>.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct ConnectionIn {
+    pub between: [usize; 2],
+    /// Single-linkage cut-off c, seconds.
+    pub cutoff: f64,
+    pub count: usize,
+    pub points: Vec<CloudPointIn>,
+    pub merges: Vec<MergeIn>,
+}
+
+/// `maps/global.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct GlobalIn {
+    /// `(window index, component index)`.
+    pub nodes: Vec<(usize, usize)>,
+    /// Pairs of node indices.
+    pub edges: Vec<(usize, usize)>,
+    /// `(window index, component, hole)` of each distinct local hole.
+    pub holes: Vec<(usize, usize, usize)>,
+    pub gluing_cycles: usize,
+    pub betti: [usize; 2],
+}
+
+/// One row of `trajectories.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Seconds.
+    pub time: f64,
+    pub agent: u32,
+    /// Metres.
+    pub x: f64,
+    pub y: f64,
+    /// 0 walk, 1 pause, 2 landmark, 3 return.
+    pub state: u8,
+}
+
+/// Everything the report reads from a run directory.
+#[derive(Debug, Clone)]
+pub struct RunData {
+    pub dir: PathBuf,
+    /// The world from `meta.json` (none for a log without metadata).
+    pub world: Option<World>,
+    pub summary: Summary,
+    /// One per summary window, in order.
+    pub windows: Vec<WindowIn>,
+    /// One per consecutive pair, in order.
+    pub connections: Vec<ConnectionIn>,
+    pub global: GlobalIn,
+    /// The encounter log (truth columns, static intervals and leader track when recorded).
+    pub log: EncounterLog,
+    /// `trajectories.csv`, sorted by (time, agent), when the run recorded it.
+    pub trajectories: Option<Vec<Sample>>,
+}
+
+const REMAP: &str = "run `swarmmap map RUN_DIR` (or `swarmmap run`) to write the maps";
+
+fn read_json<T: DeserializeOwned>(path: &Path, hint: &'static str) -> Result<T, ReportError> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(ReportError::Missing {
+                path: path.to_path_buf(),
+                hint,
+            });
+        }
+        Err(e) => return Err(invalid(path, e.to_string())),
+    };
+    serde_json::from_str(&text).map_err(|e| invalid(path, format!("not a swarmmap output: {e}")))
+}
+
+fn invalid(path: &Path, message: impl Into<String>) -> ReportError {
+    ReportError::Invalid {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+fn check_window(path: &Path, w: &WindowIn) -> Result<(), ReportError> {
+    let n = w.events.len();
+    let finite = w
+        .events
+        .iter()
+        .all(|e| e.start.is_finite() && e.point.iter().all(|x| x.is_finite()));
+    if !(finite && w.start.is_finite() && w.end.is_finite()) {
+        return Err(invalid(path, "a time or a point coordinate is not finite"));
+    }
+    for (c, comp) in w.components.iter().enumerate() {
+        if let Some(&j) = comp.events.iter().find(|&&j| j >= n) {
+            return Err(invalid(
+                path,
+                format!("component {c} lists event {j}, but the window has {n} events"),
+            ));
+        }
+        for hole in &comp.holes {
+            if let Some(&(a, b)) = hole.cycle.iter().find(|&&(a, b)| a >= n || b >= n) {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "a hole of component {c} has the edge ({a}, {b}), but the window has {n} events"
+                    ),
+                ));
+            }
+        }
+        let bars_ok = comp
+            .diagram
+            .iter()
+            .all(|b| b.birth.is_finite() && b.death.is_none_or(|d| d.is_finite()) && b.dim < 2);
+        if !bars_ok || !comp.scale.is_finite() {
+            return Err(invalid(
+                path,
+                format!(
+                    "component {c} has a bar or scale that is not finite, or of dimension above 1"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_connection(path: &Path, c: &ConnectionIn) -> Result<(), ReportError> {
+    let n = c.points.len();
+    if c.merges.len() >= n.max(1) {
+        return Err(invalid(
+            path,
+            format!(
+                "{} merges for {n} points; a dendrogram has at most n − 1",
+                c.merges.len()
+            ),
+        ));
+    }
+    for (k, m) in c.merges.iter().enumerate() {
+        // Merge k creates cluster n + k from two clusters made before it.
+        if m.a >= n + k || m.b >= n + k || m.a == m.b {
+            return Err(invalid(
+                path,
+                format!(
+                    "merge {k} joins clusters {} and {}, which do not exist yet",
+                    m.a, m.b
+                ),
+            ));
+        }
+        if m.height.is_some_and(|h| !h.is_finite()) {
+            return Err(invalid(path, format!("merge {k} has a non-finite height")));
+        }
+    }
+    let finite = c.cutoff.is_finite()
+        && c.points.iter().all(|p| {
+            p.start.is_finite()
+                && p.xy.iter().all(|x| x.is_finite())
+                && p.truth.is_none_or(|t| t.iter().all(|x| x.is_finite()))
+        });
+    if !finite {
+        return Err(invalid(
+            path,
+            "a coordinate, a time or the cut-off is not finite",
+        ));
+    }
+    Ok(())
+}
+
+fn check_global(path: &Path, g: &GlobalIn) -> Result<(), ReportError> {
+    let n = g.nodes.len();
+    if let Some(&(a, b)) = g.edges.iter().find(|&&(a, b)| a >= n || b >= n) {
+        return Err(invalid(
+            path,
+            format!("edge ({a}, {b}) names a node beyond the {n} nodes"),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads `trajectories.csv` (`time,agent,x,y,state`).
+pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
+    let file = std::fs::File::open(path).map_err(|e| invalid(path, e.to_string()))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(file);
+    let headers = reader
+        .headers()
+        .map_err(|e| invalid(path, format!("line 1: {e}")))?;
+    let expected = ["time", "agent", "x", "y", "state"];
+    if headers.iter().collect::<Vec<_>>() != expected {
+        return Err(invalid(
+            path,
+            format!("line 1: the header must be {}", expected.join(",")),
+        ));
+    }
+    let mut out = Vec::new();
+    for (k, record) in reader.records().enumerate() {
+        let line = k + 2;
+        let record = record.map_err(|e| invalid(path, format!("line {line}: {e}")))?;
+        let field = |i: usize| record.get(i).unwrap_or("");
+        let num = |i: usize| -> Result<f64, ReportError> {
+            field(i)
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    invalid(
+                        path,
+                        format!(
+                            "line {line}: column `{}` is `{}`, not a finite number",
+                            expected[i],
+                            field(i)
+                        ),
+                    )
+                })
+        };
+        let agent: u32 = field(1).parse().map_err(|_| {
+            invalid(
+                path,
+                format!(
+                    "line {line}: column `agent` is `{}`, not an agent id",
+                    field(1)
+                ),
+            )
+        })?;
+        let state = match field(4) {
+            "walk" => 0,
+            "pause" => 1,
+            "landmark" => 2,
+            "return" => 3,
+            other => {
+                return Err(invalid(
+                    path,
+                    format!("line {line}: state `{other}` is not walk, pause, landmark or return"),
+                ));
+            }
+        };
+        out.push(Sample {
+            time: num(0)?,
+            agent,
+            x: num(2)?,
+            y: num(3)?,
+            state,
+        });
+    }
+    // The simulator writes them sorted; sort anyway so a hand-made file works too.
+    out.sort_by(|p, q| p.time.total_cmp(&q.time).then(p.agent.cmp(&q.agent)));
+    Ok(out)
+}
+
+/// Reads and checks everything the report needs from a run directory.
+pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
+    if !dir.is_dir() {
+        return Err(ReportError::Missing {
+            path: dir.to_path_buf(),
+            hint: "give the directory of a run (`swarmmap run` or `swarmmap map` output)",
+        });
+    }
+    let summary_path = dir.join("summary.json");
+    let summary: Summary = read_json(&summary_path, REMAP)?;
+    let mut windows = Vec::with_capacity(summary.windows.len());
+    for w in &summary.windows {
+        let path = dir.join(format!("maps/window_{}.json", w.index));
+        let win: WindowIn = read_json(&path, REMAP)?;
+        check_window(&path, &win)?;
+        if win.index != w.index {
+            return Err(invalid(
+                &path,
+                format!("its index is {}, expected {}", win.index, w.index),
+            ));
+        }
+        windows.push(win);
+    }
+    let mut connections = Vec::with_capacity(summary.connections.len());
+    for c in &summary.connections {
+        let path = dir.join(format!("maps/connection_{}.json", c.between[0]));
+        let conn: ConnectionIn = read_json(&path, REMAP)?;
+        check_connection(&path, &conn)?;
+        connections.push(conn);
+    }
+    let global_path = dir.join("maps/global.json");
+    let global: GlobalIn = read_json(&global_path, REMAP)?;
+    check_global(&global_path, &global)?;
+    let log = EncounterLog::read_dir(dir)?;
+    for w in &windows {
+        if let Some(bad) = w
+            .events
+            .iter()
+            .filter_map(|e| e.encounter)
+            .find(|&i| i >= log.encounters.len())
+        {
+            return Err(invalid(
+                &dir.join(format!("maps/window_{}.json", w.index)),
+                format!(
+                    "event of encounter {bad}, but encounters.csv has {} rows; were the maps written from another log?",
+                    log.encounters.len()
+                ),
+            ));
+        }
+    }
+    let world = world_from_run(dir)?;
+    let traj_path = dir.join("trajectories.csv");
+    let trajectories = if traj_path.exists() {
+        Some(read_trajectories(&traj_path)?)
+    } else {
+        None
+    };
+    Ok(RunData {
+        dir: dir.to_path_buf(),
+        world,
+        summary,
+        windows,
+        connections,
+        global,
+        log,
+        trajectories,
+    })
+}

@@ -1,0 +1,237 @@
+//! `swarmmap report RUN_DIR` and the report written by `swarmmap run`: byte-identical
+//! regeneration, a run without trajectories, a log without world or truth, bad inputs
+//! (exit status 2, the file named), `--no-report`.
+
+use assert_cmd::Command;
+use predicates::str::contains;
+use std::fs;
+use std::path::Path;
+
+const FIXTURE: &str = "tests/fixtures/report/tiny";
+const TINY: &str = "tests/fixtures/worlds/tiny.ron";
+
+fn swarmmap() -> Command {
+    Command::cargo_bin("swarmmap").unwrap()
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    fs::create_dir_all(to).unwrap();
+    for entry in fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
+fn fixture_copy() -> (tempfile::TempDir, std::path::PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    copy_dir(Path::new(FIXTURE), &dir);
+    (tmp, dir)
+}
+
+fn report_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = fs::read_dir(dir.join("report"))
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn report_regenerates_byte_identical_files() {
+    let (_tmp, dir) = fixture_copy();
+    swarmmap()
+        .arg("report")
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("8 figures, with replay"));
+    let first = report_files(&dir);
+    assert_eq!(first.len(), 9, "8 figures and index.html");
+    assert!(first.iter().all(|(name, _)| !name.ends_with(".tmp")));
+    swarmmap().arg("report").arg(&dir).assert().success();
+    assert!(first == report_files(&dir), "a second report differs");
+    let html = String::from_utf8(
+        first
+            .iter()
+            .find(|f| f.0 == "index.html")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
+    // Self-contained: no external scripts, styles, images or fetches.
+    for needle in [
+        "src=\"http",
+        "href=\"http",
+        "<link rel=\"stylesheet",
+        "fetch(",
+        "XMLHttpRequest",
+    ] {
+        assert!(!html.contains(needle), "page references {needle}");
+    }
+}
+
+#[test]
+fn a_run_without_trajectories_gets_a_page_that_says_so() {
+    let (_tmp, dir) = fixture_copy();
+    fs::remove_file(dir.join("trajectories.csv")).unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("replay unavailable"));
+    let html = fs::read_to_string(dir.join("report/index.html")).unwrap();
+    assert!(html.contains("id=\"replay-unavailable\""));
+    assert!(!html.contains("id=\"replay-data\""));
+    // The environment figure still shows landmarks, from the encounters' truth columns.
+    assert!(dir.join("report/environment.svg").exists());
+}
+
+#[test]
+fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
+    let (_tmp, dir) = fixture_copy();
+    swarmmap()
+        .arg("report")
+        .arg(dir.join("nonexistent"))
+        .assert()
+        .code(2)
+        .stderr(contains("nonexistent"));
+
+    let (_t1, d1) = fixture_copy();
+    fs::remove_file(d1.join("summary.json")).unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d1)
+        .assert()
+        .code(2)
+        .stderr(contains("summary.json: file not found"));
+
+    let (_t2, d2) = fixture_copy();
+    fs::write(d2.join("maps/window_2.json"), "{ not json").unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d2)
+        .assert()
+        .code(2)
+        .stderr(contains("window_2.json"));
+
+    // A dendrogram merge that names a cluster not made yet.
+    let (_t3, d3) = fixture_copy();
+    let path = d3.join("maps/connection_1.json");
+    let mut c: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    c["merges"][0]["a"] = serde_json::json!(100_000);
+    fs::write(&path, serde_json::to_string(&c).unwrap()).unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d3)
+        .assert()
+        .code(2)
+        .stderr(contains("connection_1.json").and(contains("merge 0")));
+
+    // A hole cycle that points past the window's events.
+    let (_t4, d4) = fixture_copy();
+    let path = d4.join("maps/window_1.json");
+    let mut w: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    w["components"][0]["holes"] =
+        serde_json::json!([{"birth": 1.0, "death": 2.0, "cycle": [[0, 99999]]}]);
+    fs::write(&path, serde_json::to_string(&w).unwrap()).unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d4)
+        .assert()
+        .code(2)
+        .stderr(contains("window_1.json"));
+
+    let (_t5, d5) = fixture_copy();
+    fs::write(
+        d5.join("trajectories.csv"),
+        "time,agent,x,y,state\n0,1,2,3,flying\n",
+    )
+    .unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d5)
+        .assert()
+        .code(2)
+        .stderr(contains("trajectories.csv").and(contains("line 2")));
+    // Nothing was written for a failed report.
+    assert!(!d5.join("report").exists());
+}
+
+use predicates::prelude::PredicateBooleanExt;
+
+#[test]
+fn a_log_without_world_or_truth_gets_a_report_without_truth() {
+    let (_tmp, dir) = fixture_copy();
+    fs::remove_file(dir.join("meta.json")).unwrap();
+    fs::remove_file(dir.join("trajectories.csv")).unwrap();
+    let text = fs::read_to_string(dir.join("encounters.csv")).unwrap();
+    let stripped: String = text
+        .lines()
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    fs::write(dir.join("encounters.csv"), stripped).unwrap();
+    swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .arg(&dir)
+        .assert()
+        .success();
+    swarmmap()
+        .arg("report")
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("7 figures"));
+    let html = fs::read_to_string(dir.join("report/index.html")).unwrap();
+    assert!(html.contains("A log without a world file"));
+    assert!(!dir.join("report/environment.svg").exists());
+    let cloud = fs::read_to_string(dir.join("report/window_1_cloud.svg")).unwrap();
+    assert!(!cloud.contains("true positions"));
+}
+
+#[test]
+fn run_writes_the_report_and_trajectories_unless_told_not_to() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    swarmmap()
+        .args(["run", TINY, "--quiet", "--out"])
+        .arg(&a)
+        .assert()
+        .success()
+        .stdout(contains("report: ").and(contains("with replay")));
+    assert!(a.join("report/index.html").exists());
+    assert!(a.join("trajectories.csv").exists());
+    let meta: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(a.join("meta.json")).unwrap()).unwrap();
+    // Default interval: max(1 s, 210 s / 600) = 1 s.
+    assert_eq!(
+        meta["outputs"]["trajectory_interval"],
+        serde_json::json!(1.0)
+    );
+    swarmmap()
+        .args(["run", TINY, "--quiet", "--no-report", "--out"])
+        .arg(&b)
+        .assert()
+        .success();
+    assert!(!b.join("report").exists());
+    assert!(b.join("trajectories.csv").exists());
+    // The report can be made later.
+    swarmmap().arg("report").arg(&b).assert().success();
+    assert!(b.join("report/index.html").exists());
+}
