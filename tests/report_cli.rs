@@ -235,3 +235,22 @@ fn run_writes_the_report_and_trajectories_unless_told_not_to() {
     swarmmap().arg("report").arg(&b).assert().success();
     assert!(b.join("report/index.html").exists());
 }
+
+#[test]
+fn remapping_refreshes_an_existing_report() {
+    let (_tmp, dir) = fixture_copy();
+    swarmmap().arg("report").arg(&dir).assert().success();
+    assert!(!dir.join("report/window_3_cloud.svg").exists());
+    swarmmap()
+        .args(["map", "--windows", "3", "--overlap", "30"])
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("report refreshed"));
+    assert!(dir.join("report/window_3_cloud.svg").exists());
+    let html = fs::read_to_string(dir.join("report/index.html")).unwrap();
+    assert!(
+        html.contains("3 windows"),
+        "the page describes the new maps"
+    );
+}

@@ -1,5 +1,6 @@
 //! `swarmmap map RUN_DIR [--windows N] [--overlap S]`: local maps, connections and the
-//! global map of an encounter log, from a simulation or a real experiment.
+//! global map of an encounter log, from a simulation or a real experiment. An existing
+//! `RUN_DIR/report/` is regenerated from the new maps.
 
 use super::{Failure, input, load_world};
 use clap::Args;
@@ -85,5 +86,17 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(input)?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
+    // A report made from the previous maps would now be stale: regenerate it.
+    let page = args.run_dir.join("report").join("index.html");
+    if page.exists() {
+        swarmmap::report::write_report(&args.run_dir).map_err(|e| {
+            if e.is_input() {
+                input(e)
+            } else {
+                Failure::Other(e.into())
+            }
+        })?;
+        println!("report refreshed: {}", page.display());
+    }
     Ok(())
 }
