@@ -113,7 +113,7 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
         let winners: Vec<&Vec<f64>> = scores.iter().filter(|s| s.1 == top).map(|s| &s.0).collect();
         winners[winners.len() / 2].clone()
     };
-    let h0: Vec<(Vec<f64>, usize)> = grid(1.0, 30.0, 0.25)
+    let h0: Vec<(Vec<f64>, usize)> = grid(1.0, 100.0, 0.25)
         .into_iter()
         .map(|r| {
             let c = Classifier {

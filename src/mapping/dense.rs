@@ -23,6 +23,27 @@ pub struct DenseParams {
     pub m: usize,
 }
 
+/// Points of the planar Vietoris–Rips complex of the `Embedded` method (and of the
+/// truth-position oracle, [`crate::mapping::output::Fidelity::oracle`]).
+pub const EMBEDDED_POINTS: usize = 1200;
+
+impl DenseParams {
+    /// The `Embedded` method's topology stage: MaxMin of [`EMBEDDED_POINTS`] points on the
+    /// plane of the first two coordinates, without density filter (`keep = 1`). Measured on
+    /// the true positions of encounters (README, "Which stage loses the holes"): the filter
+    /// keeps the dense clusters of encounters at static landmarks and drops the moving
+    /// agents' encounters between them, which opens false holes in empty arenas; and with
+    /// 300 points the sampling scale σ is too coarse for 1–1.5 m obstacles.
+    pub fn embedded() -> Self {
+        Self {
+            dims: 2,
+            k: 10,
+            keep: 1.0,
+            m: EMBEDDED_POINTS,
+        }
+    }
+}
+
 impl Default for DenseParams {
     fn default() -> Self {
         Self {

@@ -75,10 +75,7 @@ impl LocalParams {
         p.bridging = Bridging::Paper;
         if m.method == crate::world::MappingMethod::Embedded {
             p.anchored = true;
-            p.embedding_rips = Some(super::dense::DenseParams {
-                m: m.subsample.min(300),
-                ..Default::default()
-            });
+            p.embedding_rips = Some(super::dense::DenseParams::embedded());
         }
         p
     }

@@ -23,9 +23,9 @@ pub struct Fidelity {
     /// positions (similarity fit), divided by the diagonal of the window's domain.
     pub procrustes: Option<f64>,
     /// (β0, β1) that the topology stage finds on the events' *true* positions: each real
-    /// component's events at their true positions, the same number of representatives
-    /// (density filter + MaxMin), planar Vietoris–Rips and the shipped `Embedded`
-    /// classifier. It separates the two sources of error: a window whose `oracle` is
+    /// component's events at their true positions, then the `Embedded` method's topology
+    /// stage (MaxMin of [`crate::mapping::dense::EMBEDDED_POINTS`] points, planar
+    /// Vietoris–Rips, the shipped `Embedded` classifier). It separates the two sources of error: a window whose `oracle` is
     /// right but whose `betti` is wrong lost its features in the metric; one whose
     /// `oracle` is wrong too lost them in the sampling or the classification.
     pub oracle: Option<[usize; 2]>,

@@ -121,10 +121,7 @@ fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
             .iter()
             .map(|&j| [truth[j][0], truth[j][1], 0.0])
             .collect();
-        let params = super::dense::DenseParams {
-            m: c.representatives.len().max(1),
-            ..Default::default()
-        };
+        let params = super::dense::DenseParams::embedded();
         let picks = super::dense::dense_maxmin(&coords, &params);
         let rows: Vec<Vec<f64>> = picks.iter().map(|&k| coords[k][..2].to_vec()).collect();
         let Ok(cloud) = PointCloud::from_rows(&rows) else {
