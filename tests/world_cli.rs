@@ -20,8 +20,8 @@ fn check_prints_a_summary_of_each_scenario() {
             .success()
             .stdout(predicate::str::contains(format!("obstacles  {obstacles}")))
             .stdout(predicate::str::contains("30 m × 10 m"))
-            .stdout(predicate::str::contains("100 agents, 10 landmarks"))
-            .stdout(predicate::str::contains("r_d = 0.01 m"))
+            .stdout(predicate::str::contains("100 agents, 30 landmarks"))
+            .stdout(predicate::str::contains("r_d = 0.1 m"))
             .stdout(predicate::str::contains("sweeps x 1.5 → 28.5 m"))
             .stdout(predicate::str::contains("sweep 5400 s = 5700 s"))
             .stdout(predicate::str::contains(format!(
@@ -80,7 +80,7 @@ fn check_applies_overrides() {
         .assert()
         .success()
         .stdout(predicate::str::contains("windows    6 with"))
-        .stdout(predicate::str::contains("50 agents, 5 landmarks"));
+        .stdout(predicate::str::contains("50 agents, 15 landmarks"));
     swarmmap()
         .args(["check", "worlds/scenario1.ron", "--set", "mapping.window=6"])
         .assert()
@@ -112,4 +112,22 @@ fn check_has_help() {
         .assert()
         .success()
         .stdout(predicate::str::contains("--set <PATH=VALUE>"));
+}
+
+/// Output piped into a reader that has already gone (`| true`) ends the command quietly:
+/// no panic message on stderr.
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_pipe_is_not_a_panic() {
+    let bin = assert_cmd::cargo::cargo_bin("swarmmap");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' check worlds/scenario1.ron | true",
+            bin.display()
+        ))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
 }

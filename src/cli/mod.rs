@@ -91,6 +91,7 @@ enum Command {
 }
 
 pub fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     if let Err(e) = swarmmap::io::install_interrupt_handler() {
         eprintln!("warning: Ctrl-C will not clean up partial files: {e}");
@@ -115,5 +116,18 @@ pub fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// Restores the default action of SIGPIPE, which Rust's runtime sets to "ignore": a command
+/// whose output is piped into `head` then ends quietly when the reader goes away, like any
+/// Unix tool, instead of panicking in `println!` on a broken pipe. Only pipes and sockets
+/// raise SIGPIPE, never the output files, so no file can be torn by it.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: `signal` with `SIG_DFL` installs no handler code; it runs first thing in
+    // `main`, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
