@@ -597,6 +597,16 @@ fn cycles_of<'w>(
 /// Figure 3: the encounter point cloud of a window (the first two coordinates of each
 /// component's embedding) coloured by time and, with truth, the same events at their true
 /// positions; the representative cycles of the robust holes drawn on both.
+/// Most events drawn per point-cloud panel: beyond it every k-th event is drawn (a fixed
+/// stride, so the figure stays deterministic), which keeps a page with r_d = 10 cm windows
+/// (5 000+ events each) small enough to mail without changing what the cloud looks like.
+pub const MAX_CLOUD_POINTS: usize = 1000;
+
+/// The stride that draws at most [`MAX_CLOUD_POINTS`] of `n` points.
+fn stride(n: usize) -> usize {
+    n.div_ceil(MAX_CLOUD_POINTS).max(1)
+}
+
 pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
     let name = format!("window_{}_cloud.svg", w.index);
     let truth: Option<Vec<(f64, f64)>> = (0..w.events.len()).map(|j| true_pos(run, w, j)).collect();
@@ -623,7 +633,8 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
                     "MDS coordinate 1 (s)",
                     "MDS coordinate 2 (s)",
                 )?;
-                c.draw_series(comp.events.iter().zip(&pts).map(|(&j, &p)| {
+                let k = stride(pts.len());
+                c.draw_series(comp.events.iter().zip(&pts).step_by(k).map(|(&j, &p)| {
                     Circle::new(p, 2, time_colour(w.events[j].start, times).filled())
                 }))?;
                 let at = |j: usize| (w.events[j].point[0], w.events[j].point[1]);
@@ -661,7 +672,8 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
                         )?;
                     }
                 }
-                c.draw_series(w.events.iter().zip(truth).map(|(e, &p)| {
+                let k = stride(truth.len());
+                c.draw_series(w.events.iter().zip(truth).step_by(k).map(|(e, &p)| {
                     let col = if e.noise {
                         NOISE
                     } else {
@@ -679,10 +691,19 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
         name,
         title: format!("W{}: encounter point cloud", w.index),
         caption: format!(
-            "Each event of W{} ({:.0}–{:.0} s) coloured by its start time (viridis: dark = early, yellow = late); black: representative cycles of the robust holes.{}",
+            "Each event of W{} ({:.0}–{:.0} s){} coloured by its start time (viridis: dark = early, yellow = late); black: representative cycles of the robust holes.{}",
             w.index,
             w.start,
             w.end,
+            if w.events.len() > MAX_CLOUD_POINTS {
+                format!(
+                    " (one event in {} drawn, of {})",
+                    stride(w.events.len()),
+                    w.events.len()
+                )
+            } else {
+                String::new()
+            },
             if truth.is_some() {
                 " Right: the same events at their true positions (grey: noise components)."
             } else {
