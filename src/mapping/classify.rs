@@ -93,6 +93,19 @@ pub struct Feature {
     pub death: f64,
 }
 
+/// The features of a persistence diagram, one per bar, in the diagram's order.
+pub fn features(diagram: &crate::topology::rips::Diagram) -> Vec<Feature> {
+    diagram
+        .bars
+        .iter()
+        .map(|b| Feature {
+            dim: b.dim,
+            birth: b.birth,
+            death: b.death,
+        })
+        .collect()
+}
+
 /// The sampling scale σ of a diagram: the median finite H0 death (0 if there is none).
 pub fn sampling_scale(features: &[Feature]) -> f64 {
     let mut d: Vec<f64> = features

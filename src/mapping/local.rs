@@ -16,7 +16,7 @@
 //! Cost per window: O(m · (n + E) log n) for the shortest paths, O(m²) memory for the
 //! metric, O(m · n) for the rows; never O(n²).
 
-use super::classify::{Classifier, Feature, sampling_scale};
+use super::classify::{Classifier, sampling_scale};
 use super::encounter_graph::{Bridging, EncounterGraph};
 use super::subsample::{SubsampleParams, subsample};
 use super::windows::Window;
@@ -264,15 +264,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 (rips_matrix(&metric, &opts), sub.picks.clone())
             }
         };
-        let features: Vec<Feature> = diagram
-            .bars
-            .iter()
-            .map(|b| Feature {
-                dim: b.dim,
-                birth: b.birth,
-                death: b.death,
-            })
-            .collect();
+        let features = super::classify::features(&diagram);
         let sigma = sampling_scale(&features);
         let mut betti = [0, 0];
         let mut bars = Vec::new();

@@ -2,7 +2,6 @@
 //! Windows are independent, so they are mapped in parallel (rayon); the result does not
 //! depend on the number of threads.
 
-use super::classify::Feature;
 use super::local::{LocalMap, LocalParams, local_map};
 use super::output::{Fidelity, WindowSummary};
 use super::windows::{Window, windows};
@@ -128,15 +127,7 @@ fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
             continue;
         };
         let diagram = rips_points(&cloud, &RipsOptions::default());
-        let features: Vec<Feature> = diagram
-            .bars
-            .iter()
-            .map(|b| Feature {
-                dim: b.dim,
-                birth: b.birth,
-                death: b.death,
-            })
-            .collect();
+        let features = super::classify::features(&diagram);
         let b = classifier.betti(&features);
         betti[0] += b[0];
         betti[1] += b[1];
