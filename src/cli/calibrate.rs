@@ -10,7 +10,7 @@ use swarmmap::eval::calibrate::{Sample, fit};
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::Models;
-use swarmmap::mapping::pipeline::{MapConfig, map_windows};
+use swarmmap::mapping::pipeline::{MapConfig, map_windows, oracle_features, true_positions};
 use swarmmap::sim::{SimOptions, simulate};
 use swarmmap::world::{MappingMethod, World};
 
@@ -33,6 +33,10 @@ pub struct CalibrateArgs {
     /// (default: `assets/classifier.json`, the model compiled into swarmmap).
     #[arg(long, default_value = "assets/classifier.json")]
     pub out: PathBuf,
+    /// Fit the truth-position oracle's model instead (the `Embedded` topology stage on the
+    /// events' true positions; `summary.json` `fidelity.oracle`) and replace its entry.
+    #[arg(long)]
+    pub oracle: bool,
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
@@ -69,7 +73,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         .num_threads(threads.max(1))
         .build()
         .map_err(|e| Failure::Other(e.into()))?;
-    let results: Vec<Result<(MappingMethod, Vec<Sample>), String>> = pool.install(|| {
+    let oracle = args.oracle;
+    let results: Vec<Result<(Target, Vec<Sample>), String>> = pool.install(|| {
         jobs.par_iter()
             .map(|&(world, seed)| {
                 let out = simulate(world, &SimOptions::new(seed))
@@ -82,11 +87,26 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     .zip(map_windows(&out.log, &cfg))
                     .map(|(w, m)| {
                         let (a, b) = window_band(world, w.start, w.end);
-                        Sample::from_map(&m, fs.betti_in_band(a, b))
+                        let truth = fs.betti_in_band(a, b);
+                        if !oracle {
+                            return Ok(Sample::from_map(&m, truth));
+                        }
+                        let positions = true_positions(&m, &out.log).ok_or_else(|| {
+                            format!("{} seed {seed}: the log has no truth columns", world.name)
+                        })?;
+                        Ok(Sample {
+                            components: oracle_features(&m, &positions),
+                            truth,
+                        })
                     })
-                    .collect();
+                    .collect::<Result<_, String>>()?;
                 eprintln!("calibrate: {} seed {seed} done", world.name);
-                Ok((world.mapping.method, samples))
+                let target = if oracle {
+                    Target::Oracle
+                } else {
+                    Target::Method(world.mapping.method)
+                };
+                Ok((target, samples))
             })
             .collect()
     });
@@ -96,7 +116,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             .map_err(input)?,
         Err(_) => Models::shipped(),
     };
-    let mut by_method: Vec<(MappingMethod, Vec<Sample>)> = Vec::new();
+    let mut by_method: Vec<(Target, Vec<Sample>)> = Vec::new();
     for r in results {
         let (method, samples) = r.map_err(|e| Failure::Other(anyhow!(e)))?;
         match by_method.iter_mut().find(|(m, _)| *m == method) {
@@ -108,8 +128,12 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     for (method, samples) in &by_method {
         let f = fit(samples).ok_or_else(|| Failure::Other(anyhow!("no training windows")))?;
         println!(
-            "{method:?}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
+            "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
              both right {:.1} %, β0 {:.1} %, β1 {:.1} %",
+            match method {
+                Target::Method(m) => format!("{m:?}"),
+                Target::Oracle => "Oracle".to_string(),
+            },
             f.classifier.h0_ratio,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
@@ -118,10 +142,14 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b0_accuracy,
             100.0 * f.b1_accuracy
         );
-        let m = models.get_mut(*method);
+        let m = match method {
+            Target::Method(method) => models.get_mut(*method),
+            Target::Oracle => &mut models.oracle,
+        };
         m.classifier = f.classifier;
         m.fitted_on = format!(
-            "swarmmap calibrate --seeds {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %)",
+            "swarmmap calibrate{} --seeds {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %)",
+            if oracle { " --oracle" } else { "" },
             args.seeds,
             args.set
                 .iter()
@@ -143,4 +171,11 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         args.out.display()
     );
     Ok(())
+}
+
+/// What a fit is for: a mapping method's model, or the truth-position oracle's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Target {
+    Method(MappingMethod),
+    Oracle,
 }

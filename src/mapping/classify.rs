@@ -41,6 +41,11 @@ pub struct Models {
     pub paper: Model,
     #[serde(rename = "Embedded")]
     pub embedded: Model,
+    /// The truth-position oracle's model ([`crate::mapping::output::Fidelity::oracle`]):
+    /// fitted on the same stage run on true positions, whose diagrams are far less noisy
+    /// than those of estimated clouds (`swarmmap calibrate --oracle`).
+    #[serde(rename = "Oracle")]
+    pub oracle: Model,
 }
 
 /// A fitted classifier and its provenance.

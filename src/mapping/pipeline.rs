@@ -58,12 +58,7 @@ pub fn true_position(t: &[f64; 4]) -> [f64; 2] {
 
 /// Geometric fidelity of a local map against the log's truth columns (none without them).
 pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
-    let truth: Option<Vec<[f64; 2]>> = map
-        .events
-        .iter()
-        .map(|&i| log.encounters[i].truth.as_ref().map(true_position))
-        .collect();
-    let Some(truth) = truth else {
+    let Some(truth) = true_positions(map, log) else {
         return Fidelity::default();
     };
     // Rank correlation over (representative, event) pairs, thinned to at most ~50 000
@@ -107,27 +102,41 @@ pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
     }
 }
 
-/// (β0, β1) of the topology stage run on the true positions `truth` (one per event of
-/// `map`) of each real component's events; see [`Fidelity::oracle`].
+/// Per real component of `map`, the features of the `Embedded` topology stage run on the
+/// true positions `truth` (one per event of `map`) of its events; see [`Fidelity::oracle`].
+pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::classify::Feature>> {
+    map.components
+        .iter()
+        .filter_map(|c| {
+            let coords: Vec<[f64; 3]> = c
+                .events
+                .iter()
+                .map(|&j| [truth[j][0], truth[j][1], 0.0])
+                .collect();
+            let picks = super::dense::dense_maxmin(&coords, &super::dense::DenseParams::embedded());
+            let rows: Vec<Vec<f64>> = picks.iter().map(|&k| coords[k][..2].to_vec()).collect();
+            let cloud = PointCloud::from_rows(&rows).ok()?;
+            Some(super::classify::features(&rips_points(
+                &cloud,
+                &RipsOptions::default(),
+            )))
+        })
+        .collect()
+}
+
+/// The true positions of a map's events, if the log has truth columns.
+pub fn true_positions(map: &LocalMap, log: &EncounterLog) -> Option<Vec<[f64; 2]>> {
+    map.events
+        .iter()
+        .map(|&i| log.encounters[i].truth.as_ref().map(true_position))
+        .collect()
+}
+
+/// (β0, β1) of the oracle: [`oracle_features`] judged by the shipped oracle model.
 fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
-    let classifier = super::classify::Models::shipped()
-        .get(crate::world::MappingMethod::Embedded)
-        .classifier;
+    let classifier = super::classify::Models::shipped().oracle.classifier;
     let mut betti = [0, 0];
-    for c in &map.components {
-        let coords: Vec<[f64; 3]> = c
-            .events
-            .iter()
-            .map(|&j| [truth[j][0], truth[j][1], 0.0])
-            .collect();
-        let params = super::dense::DenseParams::embedded();
-        let picks = super::dense::dense_maxmin(&coords, &params);
-        let rows: Vec<Vec<f64>> = picks.iter().map(|&k| coords[k][..2].to_vec()).collect();
-        let Ok(cloud) = PointCloud::from_rows(&rows) else {
-            continue;
-        };
-        let diagram = rips_points(&cloud, &RipsOptions::default());
-        let features = super::classify::features(&diagram);
+    for features in oracle_features(map, truth) {
         let b = classifier.betti(&features);
         betti[0] += b[0];
         betti[1] += b[1];
