@@ -8,9 +8,20 @@
 //! `cargo bench --bench mapping`
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use swarmmap::log::EncounterLog;
 use swarmmap::mapping::local::{LocalParams, local_map};
 use swarmmap::mapping::synthetic::{SyntheticParams, synthetic_log};
 use swarmmap::mapping::windows::Window;
+
+/// One window over the whole log.
+fn whole(log: &EncounterLog) -> Window {
+    let (start, end) = log.span().expect("non-empty log");
+    Window {
+        index: 1,
+        start,
+        end,
+    }
+}
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("local_map");
@@ -22,12 +33,7 @@ fn bench(c: &mut Criterion) {
             ..Default::default()
         };
         let log = synthetic_log(&p, n);
-        let (a, b) = log.span().expect("non-empty log");
-        let w = Window {
-            index: 1,
-            start: a,
-            end: b,
-        };
+        let w = whole(&log);
         let params = LocalParams::default();
         g.bench_function(format!("{n}_encounters"), |bch| {
             bch.iter(|| local_map(&log, &w, &params))
@@ -47,12 +53,7 @@ fn scaling(c: &mut Criterion) {
     let params = LocalParams::default();
     for n in [12_500usize, 25_000, 50_000, 100_000] {
         let log = synthetic_log(&p, n);
-        let (a, b) = log.span().expect("non-empty log");
-        let w = Window {
-            index: 1,
-            start: a,
-            end: b,
-        };
+        let w = whole(&log);
         g.throughput(Throughput::Elements(n as u64));
         g.bench_function(format!("{n}_encounters_300_agents"), |bch| {
             bch.iter(|| local_map(&log, &w, &params))

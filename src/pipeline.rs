@@ -10,7 +10,7 @@ use crate::log::{EncounterLog, LogError};
 use crate::mapping::classify::Classifier;
 use crate::mapping::local::LocalMap;
 use crate::mapping::output::{
-    ConnectionSummary, GlobalSummary, Summary, connection_json, window_json_with,
+    ConnectionSummary, GlobalSummary, Summary, connection_json, window_json,
 };
 use crate::mapping::pipeline::{MapConfig, map_windows, summarise};
 use crate::mapping::stitch::{Connection, GlobalMap, StitchParams, connect, global_map};
@@ -175,7 +175,7 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     for (map, s) in m.maps.iter().zip(&m.summary.windows) {
         write(
             format!("maps/window_{}.json", map.index),
-            window_json_with(map, log, s.truth, &m.classifier),
+            window_json(map, log, s.truth, &m.classifier),
         )?;
     }
     for c in &m.connections {

@@ -89,13 +89,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     // A report made from the previous maps would now be stale: regenerate it.
     let page = args.run_dir.join("report").join("index.html");
     if page.exists() {
-        swarmmap::report::write_report(&args.run_dir).map_err(|e| {
-            if e.is_input() {
-                input(e)
-            } else {
-                Failure::Other(e.into())
-            }
-        })?;
+        swarmmap::report::write_report(&args.run_dir).map_err(super::report::failure)?;
         println!("report refreshed: {}", page.display());
     }
     Ok(())

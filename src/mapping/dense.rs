@@ -8,6 +8,8 @@
 //! farthest-point selection so the subsample covers the dense set evenly.
 //! Cost: O(n log n) grid k-NN in the embedding for typical clouds, O(m · n) selection.
 
+use crate::topology::PointCloud;
+use crate::topology::rips::{Diagram, RipsOptions, rips_points};
 use std::collections::HashMap;
 
 /// Parameters of the dense subsample.
@@ -144,13 +146,19 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
 /// Indices (into `points`) of the dense subsample, in farthest-point order.
 pub fn dense_maxmin(points: &[[f64; 3]], p: &DenseParams) -> Vec<usize> {
     let dims = p.dims.clamp(2, 3);
-    let r = knn_radius(points, p.k, dims);
-    let mut order: Vec<usize> = (0..points.len()).collect();
-    order.sort_by(|&a, &b| r[a].total_cmp(&r[b]).then(a.cmp(&b)));
-    let kept =
-        ((points.len() as f64 * p.keep).ceil() as usize).clamp(1.min(points.len()), points.len());
-    let mut kept: Vec<usize> = order[..kept].to_vec();
-    kept.sort_unstable();
+    let kept: Vec<usize> = if p.keep >= 1.0 {
+        // Nothing is filtered: the k-NN radii would only rank points that all stay.
+        (0..points.len()).collect()
+    } else {
+        let r = knn_radius(points, p.k, dims);
+        let mut order: Vec<usize> = (0..points.len()).collect();
+        order.sort_by(|&a, &b| r[a].total_cmp(&r[b]).then(a.cmp(&b)));
+        let kept = ((points.len() as f64 * p.keep).ceil() as usize)
+            .clamp(1.min(points.len()), points.len());
+        let mut kept: Vec<usize> = order[..kept].to_vec();
+        kept.sort_unstable();
+        kept
+    };
     if kept.is_empty() {
         return kept;
     }
@@ -177,6 +185,21 @@ pub fn dense_maxmin(points: &[[f64; 3]], p: &DenseParams) -> Vec<usize> {
         }
     }
     picks
+}
+
+/// Vietoris–Rips persistence of the dense subsample of `points` (on their first
+/// `p.dims` coordinates), with the subsample as indices into `points`; `None` if a picked
+/// point is not finite.
+pub fn dense_rips(
+    points: &[[f64; 3]],
+    p: &DenseParams,
+    opts: &RipsOptions,
+) -> Option<(Diagram, Vec<usize>)> {
+    let picks = dense_maxmin(points, p);
+    let dims = p.dims.clamp(2, 3);
+    let rows: Vec<Vec<f64>> = picks.iter().map(|&k| points[k][..dims].to_vec()).collect();
+    let cloud = PointCloud::from_rows(&rows).ok()?;
+    Some((rips_points(&cloud, opts), picks))
 }
 
 #[cfg(test)]

@@ -21,9 +21,9 @@ use super::encounter_graph::{Bridging, EncounterGraph};
 use super::subsample::{SubsampleParams, subsample};
 use super::windows::Window;
 use crate::log::{Encounter, EncounterLog};
+use crate::topology::DistanceMatrix;
 use crate::topology::mds::landmark_mds;
-use crate::topology::rips::{RipsOptions, rips_matrix, rips_points};
-use crate::topology::{DistanceMatrix, PointCloud};
+use crate::topology::rips::{RipsOptions, rips_matrix};
 use serde::Serialize;
 
 /// Parameters of local mapping.
@@ -243,16 +243,9 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         let (diagram, reps) = match (&p.embedding_rips, p.witness) {
             (Some(er), _) => {
                 let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
-                let picks = super::dense::dense_maxmin(&coords, er);
-                let cloud = PointCloud::from_rows(
-                    &picks
-                        .iter()
-                        .map(|&k| coords[k][..er.dims.clamp(2, 3)].to_vec())
-                        .collect::<Vec<_>>(),
-                )
-                .expect("finite embedding");
-                let reps: Vec<usize> = picks.iter().map(|&k| members[k]).collect();
-                (rips_points(&cloud, &opts), reps)
+                let (diagram, picks) =
+                    super::dense::dense_rips(&coords, er, &opts).expect("finite embedding");
+                (diagram, picks.iter().map(|&k| members[k]).collect())
             }
             (None, Some(nu)) => {
                 let metric = super::witness::lazy_witness(&sub.rows, &members, nu);

@@ -25,9 +25,10 @@ pub struct Fidelity {
     /// (β0, β1) that the topology stage finds on the events' *true* positions: each real
     /// component's events at their true positions, then the `Embedded` method's topology
     /// stage (MaxMin of [`crate::mapping::dense::EMBEDDED_POINTS`] points, planar
-    /// Vietoris–Rips, the shipped `Embedded` classifier). It separates the two sources of error: a window whose `oracle` is
-    /// right but whose `betti` is wrong lost its features in the metric; one whose
-    /// `oracle` is wrong too lost them in the sampling or the classification.
+    /// Vietoris–Rips) judged by the shipped `Oracle` model. It separates the two sources of
+    /// error: a window whose `oracle` is right but whose `betti` is wrong lost its features
+    /// in the metric; one whose `oracle` is wrong too lost them in the sampling or the
+    /// classification.
     pub oracle: Option<[usize; 2]>,
 }
 
@@ -101,33 +102,18 @@ struct WindowOut<'a> {
     truth: Option<[usize; 2]>,
     explained: f64,
     /// The classifier's thresholds the diagrams were judged with (see `classify.rs`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    classifier: Option<Classifier>,
+    classifier: Classifier,
     events: Vec<EventOut>,
     components: &'a [super::local::Component],
 }
 
-/// The JSON text of `maps/window_<i>.json`.
-pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>) -> String {
-    window_json_impl(map, log, truth, None)
-}
-
-/// The JSON text of `maps/window_<i>.json` with the classifier's thresholds recorded (what
-/// [`crate::pipeline::write_maps`] writes, so that the report can draw them).
-pub fn window_json_with(
+/// The JSON text of `maps/window_<i>.json`, with the thresholds of the classifier the
+/// diagrams were judged with (the report draws them).
+pub fn window_json(
     map: &LocalMap,
     log: &EncounterLog,
     truth: Option<[usize; 2]>,
     classifier: &Classifier,
-) -> String {
-    window_json_impl(map, log, truth, Some(*classifier))
-}
-
-fn window_json_impl(
-    map: &LocalMap,
-    log: &EncounterLog,
-    truth: Option<[usize; 2]>,
-    classifier: Option<Classifier>,
 ) -> String {
     let events = map
         .events
@@ -154,7 +140,7 @@ fn window_json_impl(
         betti: map.betti,
         truth,
         explained: map.explained,
-        classifier,
+        classifier: *classifier,
         events,
         components: &map.components,
     };

@@ -8,8 +8,7 @@ use super::windows::{Window, windows};
 use crate::eval::fidelity::{procrustes_error, spearman};
 use crate::eval::truth::{FreeSpace, window_band};
 use crate::log::EncounterLog;
-use crate::topology::PointCloud;
-use crate::topology::rips::{RipsOptions, rips_points};
+use crate::topology::rips::RipsOptions;
 use crate::world::World;
 use rayon::prelude::*;
 
@@ -113,13 +112,12 @@ pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::cla
                 .iter()
                 .map(|&j| [truth[j][0], truth[j][1], 0.0])
                 .collect();
-            let picks = super::dense::dense_maxmin(&coords, &super::dense::DenseParams::embedded());
-            let rows: Vec<Vec<f64>> = picks.iter().map(|&k| coords[k][..2].to_vec()).collect();
-            let cloud = PointCloud::from_rows(&rows).ok()?;
-            Some(super::classify::features(&rips_points(
-                &cloud,
+            let (diagram, _) = super::dense::dense_rips(
+                &coords,
+                &super::dense::DenseParams::embedded(),
                 &RipsOptions::default(),
-            )))
+            )?;
+            Some(super::classify::features(&diagram))
         })
         .collect()
 }
