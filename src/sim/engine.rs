@@ -11,7 +11,7 @@ use crate::log::{AgentId, Encounter, EncounterLog, StaticInterval, StaticReason}
 use crate::world::World;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -257,10 +257,10 @@ struct Run<'w> {
     landmarks: Vec<usize>,
     landmarks_started: bool,
     open: HashMap<(u32, u32), (f64, [f64; 4])>,
-    /// Pairs Rapier reports within the contact prediction distance.
-    near: BTreeSet<(u32, Other)>,
-    /// Near pairs whose bodies touch (gap below [`TOUCH_GAP`]).
-    touching: BTreeSet<(u32, Other)>,
+    /// Pairs Rapier reports within the contact prediction distance, sorted, each with
+    /// whether its bodies touch (gap below [`TOUCH_GAP`]). A few dozen at most in a dense
+    /// swarm, walked every step: a sorted vector, not a tree.
+    near: Vec<((u32, Other), bool)>,
     log: EncounterLog,
     stats: SimStats,
     rng: ChaCha8Rng,
@@ -420,11 +420,12 @@ impl Run<'_> {
     }
 
     fn set_near(&mut self, pair: (u32, Other), started: bool) {
-        if started {
-            self.near.insert(pair);
-        } else {
-            self.near.remove(&pair);
-            self.touching.remove(&pair);
+        match (self.near.binary_search_by_key(&pair, |e| e.0), started) {
+            (Err(k), true) => self.near.insert(k, (pair, false)),
+            (Ok(k), false) => {
+                self.near.remove(k);
+            }
+            _ => {}
         }
     }
 
@@ -434,7 +435,8 @@ impl Run<'_> {
     fn detect_touches(&mut self, pos: &[P]) {
         let world = self.world;
         let r = world.swarm.body_radius;
-        for &(a, other) in &self.near {
+        for ((a, other), touching) in &mut self.near {
+            let (a, other) = (*a, *other);
             let pa = pos[a as usize];
             let gap = match other {
                 Other::Agent(b) => {
@@ -453,10 +455,10 @@ impl Run<'_> {
                     .fold(f64::INFINITY, f64::min),
             };
             if gap > TOUCH_GAP {
-                self.touching.remove(&(a, other));
+                *touching = false;
                 continue;
             }
-            if !self.touching.insert((a, other)) {
+            if std::mem::replace(touching, true) {
                 continue;
             }
             let mut normals: [Option<(usize, P)>; 4] = [None; 4];
@@ -522,8 +524,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         landmarks: Vec::new(),
         landmarks_started: false,
         open: HashMap::new(),
-        near: BTreeSet::new(),
-        touching: BTreeSet::new(),
+        near: Vec::new(),
         log: EncounterLog::default(),
         stats: SimStats::default(),
         rng,
@@ -579,13 +580,21 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
             run.log.leader.push((t, leader_x));
         }
         if !last {
-            for i in 0..n_agents {
-                let a = &run.agents[i];
+            // Moving agents also spend the step's length of their run (and, walking, the
+            // step's time to their next stop) here: the step ahead changes no agent's state.
+            let step_len = world.swarm.speed * dt;
+            for (i, a) in run.agents.iter_mut().enumerate() {
                 let vel = a.moving().then_some((
                     a.heading.0 * world.swarm.speed,
                     a.heading.1 * world.swarm.speed,
                 ));
                 scene.set_motion(i, vel);
+                if a.moving() {
+                    a.run_left -= step_len;
+                    if a.state == AgentState::Walk {
+                        a.stop_in -= dt;
+                    }
+                }
             }
         }
         let t0 = Instant::now();
@@ -595,13 +604,6 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         run.handle_events(&events, &pos, t);
         if last {
             break;
-        }
-        let step_len = world.swarm.speed * dt;
-        for a in run.agents.iter_mut().filter(|a| a.moving()) {
-            a.run_left -= step_len;
-            if a.state == AgentState::Walk {
-                a.stop_in -= dt;
-            }
         }
         if let Some(report) = opts.progress
             && k % progress_every == 0
