@@ -37,6 +37,10 @@ pub struct CalibrateArgs {
     /// events' true positions; `summary.json` `fidelity.oracle`) and replace its entry.
     #[arg(long)]
     pub oracle: bool,
+    /// Largest share of the training windows without a true hole in which the fitted model
+    /// may report one; accuracy is maximised under this constraint (`1` = unconstrained).
+    #[arg(long, default_value_t = swarmmap::eval::calibrate::MAX_FALSE_HOLES)]
+    pub max_false_holes: f64,
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
@@ -126,10 +130,17 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     }
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     for (method, samples) in &by_method {
-        let f = fit(samples).ok_or_else(|| Failure::Other(anyhow!("no training windows")))?;
+        let f = fit(samples, args.max_false_holes).ok_or_else(|| {
+            input(anyhow!(
+                "no classifier shows false holes in at most {} of the {} training windows \
+                 without a hole; allow more with --max-false-holes",
+                args.max_false_holes,
+                samples.iter().filter(|s| s.truth[1] == 0).count()
+            ))
+        })?;
         println!(
             "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
-             both right {:.1} %, β0 {:.1} %, β1 {:.1} %",
+             both right {:.1} %, β0 {:.1} %, β1 {:.1} %, false holes {:.1} % of hole-free windows",
             match method {
                 Target::Method(m) => format!("{m:?}"),
                 Target::Oracle => "Oracle".to_string(),
@@ -140,7 +151,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             f.windows,
             100.0 * f.accuracy,
             100.0 * f.b0_accuracy,
-            100.0 * f.b1_accuracy
+            100.0 * f.b1_accuracy,
+            100.0 * f.false_holes
         );
         let m = match method {
             Target::Method(method) => models.get_mut(*method),
@@ -148,9 +160,10 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         };
         m.classifier = f.classifier;
         m.fitted_on = format!(
-            "swarmmap calibrate{} --seeds {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %)",
+            "swarmmap calibrate{} --seeds {} --max-false-holes {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
             if oracle { " --oracle" } else { "" },
             args.seeds,
+            args.max_false_holes,
             args.set
                 .iter()
                 .map(|s| format!("--set {s} "))
@@ -159,7 +172,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             f.windows,
             100.0 * f.accuracy,
             100.0 * f.b0_accuracy,
-            100.0 * f.b1_accuracy
+            100.0 * f.b1_accuracy,
+            100.0 * f.false_holes
         );
     }
     let mut text = serde_json::to_string_pretty(&models).map_err(|e| Failure::Other(e.into()))?;

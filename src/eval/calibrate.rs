@@ -8,6 +8,14 @@
 //! towards the middle of the best plateau, which keeps the margin to either failure mode
 //! (missing a hole, inventing one) as wide as the data allow. With three parameters and
 //! thousands of windows, a grid is exact enough and cannot get stuck.
+//!
+//! The two failure modes do not cost the same: a map that invents a hole in an empty room
+//! misleads, and the acceptance target asks that an empty arena show no hole in ≥ 95 % of
+//! windows. So the H1 search is constrained: among the training windows whose truth has no
+//! hole, at most `max_false_holes` (default 2 %, a margin under the 5 % target for the gap
+//! between training and unseen worlds) may show one; accuracy is maximised under that
+//! constraint. Unconstrained (`1.0`), the Embedded model reached 80.9 % of the training
+//! windows but 3.4 % false holes there and 8.8 % in the empty arena of the evaluation.
 
 use crate::mapping::classify::{Classifier, Feature, sampling_scale};
 use crate::mapping::local::LocalMap;
@@ -61,7 +69,12 @@ pub struct Fit {
     pub b0_accuracy: f64,
     pub b1_accuracy: f64,
     pub windows: usize,
+    /// Share of the training windows without a hole in which the fitted model reports one.
+    pub false_holes: f64,
 }
+
+/// Default of [`fit`]'s `max_false_holes`.
+pub const MAX_FALSE_HOLES: f64 = 0.02;
 
 /// The grid of each threshold.
 fn grid(lo: f64, hi: f64, step: f64) -> Vec<f64> {
@@ -71,8 +84,10 @@ fn grid(lo: f64, hi: f64, step: f64) -> Vec<f64> {
 
 /// Fits the three thresholds on `samples`. β0 and β1 are decided by disjoint parameters
 /// (`h0_ratio`; `h1_ratio` and `h1_span`), so they are fitted separately and combined; the
-/// reported accuracy is that of the combination.
-pub fn fit(samples: &[Sample]) -> Option<Fit> {
+/// reported accuracy is that of the combination. The H1 thresholds are searched only where at
+/// most `max_false_holes` of the windows without a true hole show one (see the module docs);
+/// `None` if no sample is given or no grid point meets the constraint.
+pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
     if samples.is_empty() {
         return None;
     }
@@ -124,6 +139,23 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
         })
         .collect();
     let h0_ratio = best_middle(h0)[0];
+    let holeless: Vec<usize> = (0..samples.len())
+        .filter(|&k| samples[k].truth[1] == 0)
+        .collect();
+    let false_share = |c: &Classifier| -> f64 {
+        if holeless.is_empty() {
+            return 0.0;
+        }
+        let shown = holeless
+            .iter()
+            .filter(|&&k| {
+                scaled[k]
+                    .iter()
+                    .any(|(sigma, fs)| fs.iter().any(|f| f.dim == 1 && c.robust(f, *sigma)))
+            })
+            .count();
+        shown as f64 / holeless.len() as f64
+    };
     let mut h1 = Vec::new();
     for r in grid(1.0, 8.0, 0.1) {
         for span in grid(0.0, 20.0, 0.25) {
@@ -132,8 +164,13 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
                 h1_span: span,
                 ..base
             };
-            h1.push((vec![r, span], count(&|f, s| c.robust(f, s), 1)));
+            if false_share(&c) <= max_false_holes + 1e-12 {
+                h1.push((vec![r, span], count(&|f, s| c.robust(f, s), 1)));
+            }
         }
+    }
+    if h1.is_empty() {
+        return None;
     }
     let best = best_middle(h1);
     let classifier = Classifier {
@@ -155,6 +192,7 @@ pub fn fit(samples: &[Sample]) -> Option<Fit> {
         b0_accuracy: ok0 as f64 / n,
         b1_accuracy: ok1 as f64 / n,
         windows: samples.len(),
+        false_holes: false_share(&classifier),
     })
 }
 
@@ -189,8 +227,53 @@ mod tests {
                 truth: [1, 0],
             });
         }
-        let fit = fit(&samples).unwrap();
+        let fit = fit(&samples, 1.0).unwrap();
         assert_eq!(fit.accuracy, 1.0, "{fit:?}");
+        assert_eq!(fit.false_holes, 0.0);
         assert!(fit.classifier.h1_ratio > 2.0 && fit.classifier.h1_ratio <= 4.0);
+    }
+
+    /// A hole-free window holds a noise loop (ratio 5.5) between the two real holes (ratios
+    /// 5 and 6): no threshold gets all four windows right, 3 of 4 at best either way. With
+    /// no false hole allowed, the fit must pick thresholds that reject the loop.
+    #[test]
+    fn the_false_hole_constraint_holds_on_the_training_windows() {
+        let base = || -> Vec<Feature> {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            v
+        };
+        let with = |extra: &[Feature]| {
+            let mut v = base();
+            v.extend_from_slice(extra);
+            v
+        };
+        let samples = vec![
+            Sample {
+                components: vec![with(&[f(1, 1.0, 6.0)])],
+                truth: [1, 1],
+            },
+            Sample {
+                components: vec![with(&[f(1, 1.0, 5.0)])],
+                truth: [1, 1],
+            },
+            Sample {
+                components: vec![with(&[f(1, 1.0, 5.5)])],
+                truth: [1, 0],
+            },
+            Sample {
+                components: vec![with(&[])],
+                truth: [1, 0],
+            },
+        ];
+        let free = fit(&samples, 1.0).unwrap();
+        assert_eq!(free.accuracy, 0.75, "{free:?}");
+        let strict = fit(&samples, 0.0).unwrap();
+        assert_eq!(strict.false_holes, 0.0, "{strict:?}");
+        // Only the 6.0 hole survives a threshold above the 5.5 loop.
+        assert_eq!(strict.accuracy, 0.75, "{strict:?}");
+        for s in &samples[2..] {
+            assert_eq!(s.betti(&strict.classifier)[1], 0);
+        }
     }
 }

@@ -9,7 +9,9 @@
 //! 3. per real component, m representatives by density-aware MaxMin
 //!    ([`super::subsample`]); their distance rows give the m × m encounter metric for
 //!    Vietoris–Rips persistence (H0, H1) and, by landmark MDS, a 3-D embedding of every
-//!    encounter of the component (the encounter point cloud);
+//!    encounter of the component (the encounter point cloud); the `Embedded` method then
+//!    moves the encounters of moving agents between the landmarks they lead to
+//!    ([`super::bridge`]) and computes persistence on that cloud;
 //! 4. the classifier ([`super::classify`]) keeps the robust classes; (β0, β1) sum over
 //!    components.
 //!
@@ -49,6 +51,10 @@ pub struct LocalParams {
     /// Compute persistence on the encounter point cloud (the MDS embedding) after a
     /// density filter, instead of on the metric (default: `None`).
     pub embedding_rips: Option<super::dense::DenseParams>,
+    /// Place the encounters of moving agents between the landmarks their shortest paths
+    /// lead to ([`super::bridge`]) instead of where landmark MDS puts them (default:
+    /// `false`; the `Embedded` method sets it).
+    pub bridge: bool,
 }
 
 impl Default for LocalParams {
@@ -62,6 +68,7 @@ impl Default for LocalParams {
             anchored: false,
             witness: None,
             embedding_rips: None,
+            bridge: false,
         }
     }
 }
@@ -76,6 +83,7 @@ impl LocalParams {
         if m.method == crate::world::MappingMethod::Embedded {
             p.anchored = true;
             p.embedding_rips = Some(super::dense::DenseParams::embedded());
+            p.bridge = true;
         }
         p
     }
@@ -232,6 +240,15 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     c.get(1).copied().unwrap_or(0.0),
                     c.get(2).copied().unwrap_or(0.0),
                 ];
+            }
+            if p.bridge {
+                super::bridge::place_between_landmarks(
+                    &mut points,
+                    &members,
+                    &sub.picks,
+                    &sub.rows,
+                    super::bridge::EXIT_CANDIDATES,
+                );
             }
         }
         let opts = RipsOptions {

@@ -1,5 +1,6 @@
 //! Local and global mapping from encounter logs (paper §"Dynamic Topological Mapping").
 
+pub mod bridge;
 pub mod classify;
 pub mod dense;
 pub mod encounter_graph;
