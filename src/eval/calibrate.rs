@@ -15,7 +15,8 @@
 //! hole, at most `max_false_holes` (default 2 %, a margin under the 5 % target for the gap
 //! between training and unseen worlds) may show one; accuracy is maximised under that
 //! constraint. Unconstrained (`1.0`), the Embedded model reached 80.9 % of the training
-//! windows but 3.4 % false holes there and 8.8 % in the empty arena of the evaluation.
+//! windows but false holes in 4.1 % of the hole-free ones there (`swarmmap calibrate --seeds 1..5
+//! --max-false-holes 1`) and in 8.8 % of the evaluation's empty-arena windows.
 
 use crate::mapping::classify::{Classifier, Feature, sampling_scale};
 use crate::mapping::local::LocalMap;
@@ -268,6 +269,8 @@ mod tests {
         ];
         let free = fit(&samples, 1.0).unwrap();
         assert_eq!(free.accuracy, 0.75, "{free:?}");
+        // Unconstrained, the middle of the best plateau keeps the loop: the cap must bite.
+        assert!(free.false_holes > 0.0, "{free:?}");
         let strict = fit(&samples, 0.0).unwrap();
         assert_eq!(strict.false_holes, 0.0, "{strict:?}");
         // Only the 6.0 hole survives a threshold above the 5.5 loop.
