@@ -25,7 +25,7 @@ use super::windows::Window;
 use crate::log::{Encounter, EncounterLog};
 use crate::topology::DistanceMatrix;
 use crate::topology::mds::landmark_mds;
-use crate::topology::rips::{RipsOptions, rips_matrix};
+use crate::topology::rips::{RipsOptions, rips_matrix, tighten_cycle};
 use serde::Serialize;
 
 /// Parameters of local mapping.
@@ -100,7 +100,8 @@ pub struct MapBar {
 }
 
 /// A robust hole: its bar and a representative cycle as encounters (indices into the
-/// window's `events`, consecutive pairs joined by an edge of the metric).
+/// window's `events`, consecutive pairs joined by an edge of the metric): the tight loop
+/// round the hole ([`tighten_cycle`]), or the engine's representative where none exists.
 #[derive(Debug, Clone, Serialize)]
 pub struct Hole {
     pub birth: f64,
@@ -257,21 +258,31 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
             cycles: true,
             threads: 0,
         };
-        let (diagram, reps) = match (&p.embedding_rips, p.witness) {
+        // The diagram, its vertices as events, and the distances between its vertices (for
+        // the holes' tight cycles).
+        let (diagram, reps, vertex_metric) = match (&p.embedding_rips, p.witness) {
             (Some(er), _) => {
                 let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
                 let (diagram, picks) =
                     super::dense::dense_rips(&coords, er, &opts).expect("finite embedding");
-                (diagram, picks.iter().map(|&k| members[k]).collect())
+                let dims = er.dims.clamp(2, 3);
+                let metric = DistanceMatrix::from_fn(picks.len(), |a, b| {
+                    let (x, y) = (&coords[picks[a]], &coords[picks[b]]);
+                    (0..dims)
+                        .map(|i| (x[i] - y[i]) * (x[i] - y[i]))
+                        .sum::<f64>()
+                        .sqrt()
+                });
+                (diagram, picks.iter().map(|&k| members[k]).collect(), metric)
             }
             (None, Some(nu)) => {
                 let metric = super::witness::lazy_witness(&sub.rows, &members, nu);
-                (rips_matrix(&metric, &opts), sub.picks.clone())
+                (rips_matrix(&metric, &opts), sub.picks.clone(), metric)
             }
             (None, None) => {
                 let m = sub.picks.len();
                 let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
-                (rips_matrix(&metric, &opts), sub.picks.clone())
+                (rips_matrix(&metric, &opts), sub.picks.clone(), metric)
             }
         };
         let features = super::classify::features(&diagram);
@@ -285,10 +296,22 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 betti[f.dim] += 1;
             }
             if robust && f.dim == 1 {
+                // The loop that hugs the hole, not the engine's representative, which can
+                // run round most of the domain: the global map tells holes apart by their
+                // cycles' times (`stitch`), and the report draws them.
                 let cycle = bar
                     .cycle
                     .as_ref()
-                    .map(|c| c.iter().map(|&(x, y)| (reps[x], reps[y])).collect())
+                    .map(|c| {
+                        let n = vertex_metric.len();
+                        let tight = tighten_cycle(n, |a, b| vertex_metric.get(a, b), c);
+                        tight
+                            .as_deref()
+                            .unwrap_or(c)
+                            .iter()
+                            .map(|&(x, y)| (reps[x], reps[y]))
+                            .collect()
+                    })
                     .unwrap_or_default();
                 holes.push(Hole {
                     birth: f.birth,

@@ -7,7 +7,8 @@
 //! *cohomology* with clearing, an implicit coboundary over simplices named by the
 //! combinatorial number system, apparent and emergent pairs, the enclosing radius as the
 //! default threshold and union–find-equivalent spanning trees for H0. `engine.rs` documents
-//! the stages and their cost, `cycles.rs` the representative cycles of H1 bars.
+//! the stages and their cost, `cycles.rs` the representative cycles of H1 bars, `tight.rs`
+//! the tight loop round a hole that maps draw ([`tighten_cycle`]).
 //!
 //! In short, for `n` points: `O(n²)` time for H0, and for H1 `O(n²)` vertex probes on
 //! generic inputs plus the reduction of the few edges not in an apparent pair; memory
@@ -32,9 +33,11 @@ mod diagram;
 mod engine;
 mod metric;
 mod params;
+mod tight;
 
 pub use diagram::{Bar, Diagram};
 pub use params::{RipsError, RipsOptions};
+pub use tight::tighten_cycle;
 
 use crate::topology::{DistanceMatrix, PointCloud};
 use metric::{Full, Metric, Points};
