@@ -57,7 +57,8 @@ impl Default for DenseParams {
     }
 }
 
-fn dist(a: &[f64; 3], b: &[f64; 3], dims: usize) -> f64 {
+/// Euclidean distance on the first `dims` coordinates.
+pub(crate) fn dist(a: &[f64; 3], b: &[f64; 3], dims: usize) -> f64 {
     (0..dims)
         .map(|i| (a[i] - b[i]) * (a[i] - b[i]))
         .sum::<f64>()

@@ -149,6 +149,30 @@ pub struct LocalMap {
     pub rows: Vec<(usize, Vec<f64>)>,
 }
 
+/// Distances between the vertices of a component's Rips complex.
+enum VertexMetric {
+    /// Points of the embedded cloud, compared on their first `dims` coordinates.
+    Coords(Vec<[f64; 3]>, usize),
+    /// An explicit matrix (the encounter metric or the witness metric).
+    Matrix(DistanceMatrix),
+}
+
+impl VertexMetric {
+    fn len(&self) -> usize {
+        match self {
+            Self::Coords(p, _) => p.len(),
+            Self::Matrix(m) => m.len(),
+        }
+    }
+
+    fn dist(&self, a: usize, b: usize) -> f64 {
+        match self {
+            Self::Coords(p, dims) => super::dense::dist(&p[a], &p[b], *dims),
+            Self::Matrix(m) => m.get(a, b),
+        }
+    }
+}
+
 /// Builds the local map of `window` from `log`.
 pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalMap {
     let events: Vec<usize> = log
@@ -265,24 +289,20 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
                 let (diagram, picks) =
                     super::dense::dense_rips(&coords, er, &opts).expect("finite embedding");
-                let dims = er.dims.clamp(2, 3);
-                let metric = DistanceMatrix::from_fn(picks.len(), |a, b| {
-                    let (x, y) = (&coords[picks[a]], &coords[picks[b]]);
-                    (0..dims)
-                        .map(|i| (x[i] - y[i]) * (x[i] - y[i]))
-                        .sum::<f64>()
-                        .sqrt()
-                });
+                let picked = picks.iter().map(|&k| coords[k]).collect();
+                let metric = VertexMetric::Coords(picked, er.dims.clamp(2, 3));
                 (diagram, picks.iter().map(|&k| members[k]).collect(), metric)
             }
             (None, Some(nu)) => {
                 let metric = super::witness::lazy_witness(&sub.rows, &members, nu);
-                (rips_matrix(&metric, &opts), sub.picks.clone(), metric)
+                let diagram = rips_matrix(&metric, &opts);
+                (diagram, sub.picks.clone(), VertexMetric::Matrix(metric))
             }
             (None, None) => {
                 let m = sub.picks.len();
                 let metric = DistanceMatrix::from_fn(m, |a, b| sub.rows[a][sub.picks[b]]);
-                (rips_matrix(&metric, &opts), sub.picks.clone(), metric)
+                let diagram = rips_matrix(&metric, &opts);
+                (diagram, sub.picks.clone(), VertexMetric::Matrix(metric))
             }
         };
         let features = super::classify::features(&diagram);
@@ -304,7 +324,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     .as_ref()
                     .map(|c| {
                         let n = vertex_metric.len();
-                        let tight = tighten_cycle(n, |a, b| vertex_metric.get(a, b), c);
+                        let tight = tighten_cycle(n, |a, b| vertex_metric.dist(a, b), c);
                         tight
                             .as_deref()
                             .unwrap_or(c)
