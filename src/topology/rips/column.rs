@@ -7,6 +7,13 @@
 //! last minimum, pushes are `O(1)` appends, and a pop only redistributes one bin. For the
 //! long columns of big holes (millions of entries, most of them cancelling in pairs) this
 //! beats a binary heap, whose sift-downs miss the cache at every level.
+//!
+//! Monotone only up to cancellation: the engine keeps reduction-matrix columns (edges) and
+//! adds a column by pushing the coboundary of each of its edges, so entries older than the
+//! current pivot do arrive. Their sum cancels below the pivot, but each entry alone can be
+//! older than `last`, where the radix bins would misplace it. Such entries go to a separate
+//! binary heap, `below`, which is consulted first: it is empty in the common case, and
+//! whatever survives cancellation there is older than everything in the bins.
 
 use std::collections::BinaryHeap;
 
@@ -20,6 +27,8 @@ pub(crate) struct Column {
     top: BinaryHeap<Tri>,
     /// Bin `i` (1..=64): entries whose value differs from `last` first in bit `i − 1`.
     bins: Vec<Vec<Tri>>,
+    /// Entries whose value was below `last` when pushed.
+    below: BinaryHeap<Tri>,
     len: usize,
 }
 
@@ -29,6 +38,7 @@ impl Column {
             last: 0,
             top: BinaryHeap::new(),
             bins: vec![Vec::new(); 65],
+            below: BinaryHeap::new(),
             len: 0,
         }
     }
@@ -39,6 +49,7 @@ impl Column {
         for b in &mut self.bins {
             b.clear();
         }
+        self.below.clear();
         self.len = 0;
     }
 
@@ -47,12 +58,13 @@ impl Column {
         self.len
     }
 
-    /// Adds an entry; it must not be older than the last pivot returned.
+    /// Adds an entry.
     #[inline]
     pub(crate) fn push(&mut self, t: Tri) {
-        debug_assert!(t.v >= self.last);
         self.len += 1;
-        if t.v == self.last {
+        if t.v < self.last {
+            self.below.push(t);
+        } else if t.v == self.last {
             self.top.push(t);
         } else {
             let i = 64 - (t.v ^ self.last).leading_zeros() as usize;
@@ -62,6 +74,15 @@ impl Column {
 
     /// The oldest entry after cancelling pairs (it stays in the column).
     pub(crate) fn pivot(&mut self) -> Option<Tri> {
+        while let Some(x) = self.below.pop() {
+            if self.below.peek() == Some(&x) {
+                self.below.pop();
+                self.len -= 2;
+                continue;
+            }
+            self.below.push(x);
+            return Some(x);
+        }
         loop {
             if let Some(x) = self.top.pop() {
                 if self.top.peek() == Some(&x) {
@@ -94,6 +115,10 @@ impl Column {
         canonical(&mut top);
         self.len = top.len();
         self.top = BinaryHeap::from(top);
+        let mut below = std::mem::take(&mut self.below).into_vec();
+        canonical(&mut below);
+        self.len += below.len();
+        self.below = BinaryHeap::from(below);
         for b in &mut self.bins {
             canonical(b);
             self.len += b.len();
@@ -129,6 +154,42 @@ mod tests {
         assert_eq!(c.len(), 1);
         assert_eq!(c.pivot(), Some(t(3.0, 6)));
         c.push(t(3.0, 6));
+        assert_eq!(c.pivot(), None);
+    }
+
+    /// Entries older than the last pivot (a reduction adding the coboundaries of a
+    /// column's edges one by one) are ordered correctly and cancel in pairs.
+    #[test]
+    fn entries_below_the_last_pivot_keep_the_order() {
+        let t = |v: f64, a| Tri::new(v, a, 1, 0);
+        let mut c = Column::new();
+        for x in [t(8.0, 2), t(12.0, 3), t(16.0, 4)] {
+            c.push(x);
+        }
+        assert_eq!(c.pivot(), Some(t(8.0, 2)));
+        // Add a column whose sum is {8 (cancels the pivot), 9}, pushed with a pair at 7
+        // and a pair at 6 that cancel below the pivot.
+        for x in [
+            t(7.0, 5),
+            t(8.0, 2),
+            t(6.0, 6),
+            t(9.0, 7),
+            t(7.0, 5),
+            t(6.0, 6),
+        ] {
+            c.push(x);
+        }
+        assert_eq!(c.pivot(), Some(t(9.0, 7)));
+        // One unpaired entry below the pivot is the new pivot.
+        c.push(t(5.0, 8));
+        assert_eq!(c.pivot(), Some(t(5.0, 8)));
+        c.compact();
+        assert_eq!(c.len(), 4);
+        c.push(t(5.0, 8));
+        assert_eq!(c.pivot(), Some(t(9.0, 7)));
+        c.push(t(9.0, 7));
+        assert_eq!(c.pivot(), Some(t(12.0, 3)));
+        c.clear();
         assert_eq!(c.pivot(), None);
     }
 }
