@@ -356,7 +356,7 @@ mod tests {
             index,
             start: 0.0,
             end: 0.0,
-            events: events.clone(),
+            events,
             points: vec![[0.0; 3]; n],
             noise: vec![false; n],
             components: vec![Component {

@@ -17,7 +17,7 @@
 
 use std::collections::BinaryHeap;
 
-use super::engine::{Tri, canonical};
+use super::engine::{Tri, canonical, pop_pivot};
 
 /// A Z/2 column of triangles with a monotone "oldest entry" query.
 pub(crate) struct Column {
@@ -74,23 +74,11 @@ impl Column {
 
     /// The oldest entry after cancelling pairs (it stays in the column).
     pub(crate) fn pivot(&mut self) -> Option<Tri> {
-        while let Some(x) = self.below.pop() {
-            if self.below.peek() == Some(&x) {
-                self.below.pop();
-                self.len -= 2;
-                continue;
-            }
-            self.below.push(x);
+        if let Some(x) = pop_counted(&mut self.below, &mut self.len) {
             return Some(x);
         }
         loop {
-            if let Some(x) = self.top.pop() {
-                if self.top.peek() == Some(&x) {
-                    self.top.pop();
-                    self.len -= 2;
-                    continue;
-                }
-                self.top.push(x);
+            if let Some(x) = pop_counted(&mut self.top, &mut self.len) {
                 return Some(x);
             }
             let i = self.bins.iter().position(|b| !b.is_empty())?;
@@ -124,6 +112,14 @@ impl Column {
             self.len += b.len();
         }
     }
+}
+
+/// [`pop_pivot`] on one of the column's heaps, taking the cancelled pairs off `len`.
+fn pop_counted(heap: &mut BinaryHeap<Tri>, len: &mut usize) -> Option<Tri> {
+    let before = heap.len();
+    let x = pop_pivot(heap);
+    *len -= before - heap.len();
+    x
 }
 
 #[cfg(test)]

@@ -98,7 +98,29 @@ pub fn tighten_cycle(
 mod tests {
     use super::*;
     use crate::topology::PointCloud;
-    use crate::topology::rips::{RipsOptions, rips_points};
+    use crate::topology::rips::{Diagram, RipsOptions, rips_points};
+
+    /// The Rips diagram of `p` with representative cycles.
+    fn diagram(p: &[[f64; 2]]) -> Diagram {
+        let rows: Vec<Vec<f64>> = p.iter().map(|q| q.to_vec()).collect();
+        rips_points(
+            &PointCloud::from_rows(&rows).unwrap(),
+            &RipsOptions {
+                cycles: true,
+                ..Default::default()
+            },
+        )
+    }
+
+    /// A 64-bit linear congruential generator (Knuth's MMIX constants) from `seed`.
+    fn lcg(mut seed: u64) -> impl FnMut() -> u64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            seed
+        }
+    }
 
     fn euclid(p: &[[f64; 2]]) -> impl Fn(usize, usize) -> f64 + '_ {
         |a, b| (p[a][0] - p[b][0]).hypot(p[a][1] - p[b][1])
@@ -175,14 +197,7 @@ mod tests {
     #[test]
     fn the_tight_cycle_of_a_ring_is_the_ring() {
         let p = ring_in_plate();
-        let rows: Vec<Vec<f64>> = p.iter().map(|q| q.to_vec()).collect();
-        let d = rips_points(
-            &PointCloud::from_rows(&rows).unwrap(),
-            &RipsOptions {
-                cycles: true,
-                ..Default::default()
-            },
-        );
+        let d = diagram(&p);
         let bar = d
             .dim(1)
             .max_by(|a, b| a.persistence().total_cmp(&b.persistence()))
@@ -202,25 +217,13 @@ mod tests {
     /// path found by Floyd–Warshall over the edges shorter than the birth edge, plus it.
     #[test]
     fn matches_floyd_warshall_on_small_clouds() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = lcg(7);
+        let mut rnd = || (next() >> 11) as f64 / (1u64 << 53) as f64;
         let mut checked = 0;
         for _ in 0..40 {
             let n = 20;
             let p: Vec<[f64; 2]> = (0..n).map(|_| [rnd(), rnd()]).collect();
-            let rows: Vec<Vec<f64>> = p.iter().map(|q| q.to_vec()).collect();
-            let d = rips_points(
-                &PointCloud::from_rows(&rows).unwrap(),
-                &RipsOptions {
-                    cycles: true,
-                    ..Default::default()
-                },
-            );
+            let d = diagram(&p);
             for bar in d.dim(1) {
                 let Some(cycle) = bar.cycle.as_ref() else {
                     continue;
@@ -325,13 +328,8 @@ mod tests {
     /// bar's class at its birth (not a boundary there), and ties give `None`.
     #[test]
     fn tight_cycles_are_never_boundaries_even_with_ties() {
-        let mut seed = 11u64;
-        let mut rnd = |m: u64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 33) % m
-        };
+        let mut next = lcg(11);
+        let mut rnd = |m: u64| (next() >> 33) % m;
         let (mut some, mut none) = (0, 0);
         for _ in 0..120 {
             let mut p: Vec<[f64; 2]> = Vec::new();
@@ -341,14 +339,7 @@ mod tests {
                     p.push(q);
                 }
             }
-            let rows: Vec<Vec<f64>> = p.iter().map(|q| q.to_vec()).collect();
-            let d = rips_points(
-                &PointCloud::from_rows(&rows).unwrap(),
-                &RipsOptions {
-                    cycles: true,
-                    ..Default::default()
-                },
-            );
+            let d = diagram(&p);
             for bar in d.dim(1).filter(|b| b.death.is_finite()) {
                 let Some(cycle) = bar.cycle.as_ref() else {
                     continue;
