@@ -259,3 +259,36 @@ fn landmark_fraction_holds_inside_the_leaders_domain() {
         assert!(pts.windows(2).all(|p| p[0].x == p[1].x && p[0].y == p[1].y));
     }
 }
+
+#[test]
+fn walkers_never_press_into_a_wall_they_touch() {
+    // Runs never end on their own here, so an agent turned towards a wall it already
+    // touches (in a corner, after leaving the other side; or by another contact) would
+    // press into it, sliding or stuck, for the rest of the run unless that counts as a
+    // collision. A departing agent leaves the wall by v dt sin θ per step.
+    let mut w = still_world(2.0, 2.0, 30, 600.0);
+    w.swarm.mean_run_length = 1e6;
+    w.swarm.stop_rate = 0.0;
+    w.swarm.landmark_fraction = 0.0;
+    let out = run(&w, 11, w.simulation.dt);
+    let r = w.swarm.body_radius;
+    let gap = |x: f64, y: f64| w.clearance((x, y)) - r;
+    let mut longest = 0;
+    for track in tracks(&out, 30) {
+        let mut pressing = 0;
+        for p in track.windows(2) {
+            let (g0, g1) = (gap(p[0].1, p[0].2), gap(p[1].1, p[1].2));
+            let walking = p[0].3 == AgentState::Walk && p[1].3 == AgentState::Walk;
+            if walking && g0 < 1e-4 && g1 < 1e-4 && (g1 - g0).abs() < 1e-6 {
+                pressing += 1;
+                longest = longest.max(pressing);
+            } else {
+                pressing = 0;
+            }
+        }
+    }
+    assert!(
+        longest <= 3,
+        "an agent pressed into a wall for {longest} steps"
+    );
+}

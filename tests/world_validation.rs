@@ -232,6 +232,18 @@ fn meaningless_numbers_are_rejected_everywhere() {
         ("swarm.stop_rate", "-0.01", "must be ≥ 0 per second"),
         ("swarm.mean_stop_duration", "0.0", "must be > 0 seconds"),
         ("swarm.comm_radius", "-1.0", "must be > 0 metres"),
+        (
+            "swarm.wall_following",
+            "1.5",
+            "must be a probability in [0, 1]",
+        ),
+        (
+            "swarm.wall_following",
+            "-0.1",
+            "must be a probability in [0, 1]",
+        ),
+        ("swarm.wall_following", "NaN", "must be a finite number"),
+        ("swarm.wall_following_length", "0.0", "must be > 0 metres"),
         ("swarm.placement", "Disk(radius: 0.0)", "must be > 0 metres"),
         (
             "swarm.placement",

@@ -36,6 +36,15 @@ const HEADING_TRIES: usize = 64;
 /// speculative contacts stop bodies at a gap of zero, up to f32 rounding.
 const TOUCH_GAP: f64 = 1e-4;
 
+/// A moving agent whose heading points into a wall or agent it still touches, by more
+/// than this cosine, collides with it again (it was turned there by another contact or
+/// by the end of a run, and would otherwise press into it until its next turn).
+const PRESS_EPS: f64 = 1e-9;
+
+/// A wall follower whose gap to its wall exceeds this many steps of travel has lost it
+/// (pushed off, or round a corner too sharp to hug) and turns away.
+const FOLLOW_LOST: f64 = 3.0;
+
 type P = (f64, f64);
 
 /// What an agent's body can touch.
@@ -45,8 +54,22 @@ enum Other {
     Agent(u32),
     /// `World::obstacles[k]`.
     Obstacle(u32),
-    /// The arena's sides.
-    Sides,
+    /// Side `j` of the arena, in the order of [`side_gaps`] (left, right, bottom, top).
+    Side(u8),
+}
+
+/// Wall following (the cockroach model's WF mode, Jeanson et al. 2003): the agent walks
+/// along the boundary of `wall` in the direction `sense` until its run (`run_left`, drawn
+/// with mean `swarm.wall_following_length`) is spent, then turns away from the wall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Follow {
+    /// `Other::Obstacle(k)` or `Other::Side(j)`.
+    wall: Other,
+    /// +1: the wall on the agent's left (anticlockwise round an obstacle, along the
+    /// tangent `n` turned by +90°, `n` the wall's outward normal); −1: on its right.
+    sense: f64,
+    /// Started at this step (counted once in the statistics).
+    fresh: bool,
 }
 
 struct Agent {
@@ -61,8 +84,10 @@ struct Agent {
     static_since: f64,
     /// End of the current pause, seconds.
     pause_until: f64,
-    /// Outward normals of the contacts that started at the last step.
-    normals: Vec<P>,
+    /// Outward normals of the contacts that started at the last step, with what was touched.
+    normals: Vec<(P, Other)>,
+    /// The wall being followed, if any (`swarm.wall_following`).
+    follow: Option<Follow>,
     /// Boxed: the generator's state and block buffer (≈ 300 bytes) would otherwise make
     /// the per-step passes over all agents stream through about four times more memory.
     rng: Box<ChaCha8Rng>,
@@ -94,6 +119,7 @@ impl Agent {
             static_since: 0.0,
             pause_until: 0.0,
             normals: Vec::new(),
+            follow: None,
             rng: Box::new(rng),
         }
     }
@@ -118,7 +144,9 @@ impl Agent {
                 unit(2.0 * PI * rng.random::<f64>())
             }
         };
-        let away = |h: P, normals: &[P]| normals.iter().all(|n| h.0 * n.0 + h.1 * n.1 >= 0.0);
+        let away = |h: P, normals: &[(P, Other)]| {
+            normals.iter().all(|(n, _)| h.0 * n.0 + h.1 * n.1 >= 0.0)
+        };
         for _ in 0..HEADING_TRIES {
             let h = draw(&mut self.rng);
             if away(h, &self.normals) {
@@ -127,7 +155,7 @@ impl Agent {
             }
             // Mirroring across the contact plane keeps the draw uniform on the free side
             // when there is one contact.
-            if let [n] = self.normals[..] {
+            if let [(n, _)] = self.normals[..] {
                 let d = h.0 * n.0 + h.1 * n.1;
                 self.heading = (h.0 - 2.0 * d * n.0, h.1 - 2.0 * d * n.1);
                 return;
@@ -136,7 +164,7 @@ impl Agent {
         let s = self
             .normals
             .iter()
-            .fold((0.0, 0.0), |s, n| (s.0 + n.0, s.1 + n.1));
+            .fold((0.0, 0.0), |s, (n, _)| (s.0 + n.0, s.1 + n.1));
         let len = s.0.hypot(s.1);
         if len > 0.0 {
             self.heading = (s.0 / len, s.1 / len);
@@ -153,6 +181,65 @@ impl Agent {
         self.run_left = exponential(&mut self.rng, mean);
     }
 
+    /// Handles the contacts of the last step (`normals`) under wall following; `false`
+    /// when they end the run with a turn, as in the paper's random walk.
+    ///
+    /// Only walls (obstacles, the arena's sides) are followed, and only by walking agents:
+    /// an agent met ends the run. Touching the wall being followed is what following
+    /// does; a different wall met (a concave corner where two obstacles, or an obstacle
+    /// and a side, meet) is followed on in the same sense. Otherwise a wall hit starts
+    /// following with probability `swarm.wall_following`, in the direction of the
+    /// tangent nearer the agent's heading, for a length drawn with mean
+    /// `swarm.wall_following_length`. No random number is drawn when the probability is
+    /// 0, so the paper's random walk keeps its exact sequence of draws.
+    fn wall_contact(&mut self, world: &World, p: P) -> bool {
+        let prob = world.swarm.wall_following;
+        if prob <= 0.0 || self.state != AgentState::Walk {
+            return false;
+        }
+        if self
+            .normals
+            .iter()
+            .any(|(_, o)| matches!(o, Other::Agent(_)))
+        {
+            // The turn away from the agent met must also lead away from the wall being
+            // followed (still touched, so no new contact reports it), or the agent would
+            // press into the wall until its next run.
+            if let Some(f) = self.follow.take()
+                && let Some((_, n)) = wall_geometry(world, f.wall, p)
+            {
+                self.normals.push((n, f.wall));
+            }
+            return false;
+        }
+        if let Some(f) = &mut self.follow {
+            if let Some(&(_, o)) = self.normals.iter().find(|(_, o)| *o != f.wall) {
+                f.wall = o;
+            }
+            return true;
+        }
+        if self.rng.random::<f64>() >= prob {
+            return false;
+        }
+        let Some(&(n, wall)) = self.normals.first() else {
+            return false;
+        };
+        let t = tangent(n, 1.0);
+        let along = self.heading.0 * t.0 + self.heading.1 * t.1;
+        let sense = if along > 0.0 || (along == 0.0 && self.rng.random::<bool>()) {
+            1.0
+        } else {
+            -1.0
+        };
+        self.follow = Some(Follow {
+            wall,
+            sense,
+            fresh: true,
+        });
+        self.run_left = exponential(&mut self.rng, world.swarm.wall_following_length);
+        true
+    }
+
     fn moving(&self) -> bool {
         matches!(self.state, AgentState::Walk | AgentState::Return)
     }
@@ -165,6 +252,37 @@ fn gradient(f: impl Fn(P) -> f64, p: P) -> Option<P> {
     let gy = f((p.0, p.1 + h)) - f((p.0, p.1 - h));
     let len = gx.hypot(gy);
     (len > 0.0 && len.is_finite()).then(|| (gx / len, gy / len))
+}
+
+/// The tangent of a wall with outward normal `n`, in the direction `sense` (±1).
+fn tangent(n: P, sense: f64) -> P {
+    (-sense * n.1, sense * n.0)
+}
+
+/// The heading of a wall follower: along the wall's tangent, turned towards the wall by
+/// enough to close a `gap` in one `step` (up to 45°), so that it stays in contact round
+/// convex corners and curves; the physics stops it at contact.
+fn follow_heading(n: P, sense: f64, gap: f64, step: f64) -> P {
+    let t = tangent(n, sense);
+    let c = (gap / step).clamp(0.0, 1.0);
+    let h = (t.0 - c * n.0, t.1 - c * n.1);
+    let len = h.0.hypot(h.1);
+    (h.0 / len, h.1 / len)
+}
+
+/// The gap between a body at `p` and the followed `wall`, and the wall's outward normal
+/// there (for a side, the normal pointing into the arena).
+fn wall_geometry(world: &World, wall: Other, p: P) -> Option<(f64, P)> {
+    let r = world.swarm.body_radius;
+    match wall {
+        Other::Obstacle(k) => {
+            let o = world.obstacles.get(k as usize)?;
+            let n = gradient(|q| o.signed_distance(q), p)?;
+            Some((o.signed_distance(p) - r, n))
+        }
+        Other::Side(j) => side_gaps(world, p, r).get(usize::from(j)).copied(),
+        Other::Agent(_) => None,
+    }
 }
 
 /// Gaps between a body of radius `r` at `p` and the arena's four sides, with the
@@ -281,6 +399,7 @@ impl Run<'_> {
         let a = &mut self.agents[i];
         a.state = AgentState::Walk;
         a.normals.clear();
+        a.follow = None;
         a.new_heading(p.0, leader_x);
         a.new_run(self.world);
     }
@@ -308,18 +427,46 @@ impl Run<'_> {
             return;
         }
         if !inside && a.state == AgentState::Walk {
+            // Returning agents follow the leader's gradient, not walls.
             a.state = AgentState::Return;
+            a.follow = None;
             a.new_heading(p.0, leader_x);
             a.new_run(world);
         } else if inside && a.state == AgentState::Return {
             a.state = AgentState::Walk;
         }
         if !a.normals.is_empty() {
-            // A contact ends the run: turn away and draw a new run length.
-            a.new_heading(p.0, leader_x);
-            a.new_run(world);
+            if !a.wall_contact(world, p) {
+                // A contact ends the run: turn away and draw a new run length.
+                a.follow = None;
+                a.new_heading(p.0, leader_x);
+                a.new_run(world);
+                self.stats.collisions += 1;
+            } else if a.follow.is_some_and(|f| f.fresh) {
+                self.stats.wall_follows += 1;
+            }
             a.normals.clear();
-            self.stats.collisions += 1;
+        }
+        if let Some(f) = &mut a.follow {
+            f.fresh = false;
+            let f = *f;
+            let step = world.swarm.speed * world.simulation.dt;
+            match wall_geometry(world, f.wall, p) {
+                Some((gap, n)) if a.run_left > 0.0 && gap <= FOLLOW_LOST * step => {
+                    a.heading = follow_heading(n, f.sense, gap, step);
+                }
+                wall => {
+                    // The followed length is spent (or the wall was lost): turn away from
+                    // the wall and start a new random-walk run.
+                    a.follow = None;
+                    if let Some((_, n)) = wall {
+                        a.normals.push((n, f.wall));
+                    }
+                    a.new_heading(p.0, leader_x);
+                    a.normals.clear();
+                    a.new_run(world);
+                }
+            }
         } else if a.run_left <= 0.0 {
             a.new_heading(p.0, leader_x);
             a.new_run(world);
@@ -408,8 +555,8 @@ impl Run<'_> {
                     obstacle,
                     started,
                 } => {
-                    let other = if obstacle == SIDES {
-                        Other::Sides
+                    let other = if obstacle > SIDES - 4 {
+                        Other::Side((SIDES - obstacle) as u8)
                     } else {
                         Other::Obstacle(obstacle)
                     };
@@ -449,19 +596,36 @@ impl Run<'_> {
                     };
                     o.signed_distance(pa) - r
                 }
-                Other::Sides => side_gaps(world, pa, r)
-                    .iter()
-                    .map(|s| s.0)
-                    .fold(f64::INFINITY, f64::min),
+                Other::Side(j) => match side_gaps(world, pa, r).get(usize::from(j)) {
+                    Some(s) => s.0,
+                    None => continue,
+                },
             };
             if gap > TOUCH_GAP {
                 *touching = false;
                 continue;
             }
-            if std::mem::replace(touching, true) {
-                continue;
+            let fresh = !std::mem::replace(touching, true);
+            // A continuing touch matters only to a moving agent heading into it (turned
+            // there by another contact or a run's end): skip the normals otherwise.
+            // (A follower steers into its own wall on purpose.)
+            let heading_in = |ag: &Agent, n: P, o: Other| {
+                ag.moving()
+                    && ag.heading.0 * n.0 + ag.heading.1 * n.1 < -PRESS_EPS
+                    && ag.follow.is_none_or(|f| f.wall != o)
+            };
+            if !fresh {
+                let idle = match other {
+                    Other::Agent(b) => {
+                        !self.agents[a as usize].moving() && !self.agents[b as usize].moving()
+                    }
+                    _ => !self.agents[a as usize].moving(),
+                };
+                if idle {
+                    continue;
+                }
             }
-            let mut normals: [Option<(usize, P)>; 4] = [None; 4];
+            let mut normals: [Option<(usize, P, Other)>; 4] = [None; 4];
             match other {
                 Other::Agent(b) => {
                     let pb = pos[b as usize];
@@ -469,28 +633,28 @@ impl Run<'_> {
                     let len = d.0.hypot(d.1);
                     if len > 0.0 {
                         let n = (d.0 / len, d.1 / len);
-                        normals[0] = Some((a as usize, n));
-                        normals[1] = Some((b as usize, (-n.0, -n.1)));
+                        normals[0] = Some((a as usize, n, Other::Agent(b)));
+                        normals[1] = Some((b as usize, (-n.0, -n.1), Other::Agent(a)));
                     }
                 }
                 Other::Obstacle(k) => {
                     if let Some(o) = world.obstacles.get(k as usize) {
-                        normals[0] =
-                            gradient(|q| o.signed_distance(q), pa).map(|n| (a as usize, n));
+                        normals[0] = gradient(|q| o.signed_distance(q), pa)
+                            .map(|n| (a as usize, n, Other::Obstacle(k)));
                     }
                 }
-                Other::Sides => {
-                    let sides = side_gaps(world, pa, r);
-                    for (slot, (g, n)) in normals.iter_mut().zip(sides) {
-                        if g <= TOUCH_GAP {
-                            *slot = Some((a as usize, n));
-                        }
+                Other::Side(j) => {
+                    if let Some(&(_, n)) = side_gaps(world, pa, r).get(usize::from(j)) {
+                        normals[0] = Some((a as usize, n, Other::Side(j)));
                     }
                 }
             }
-            for (i, n) in normals.into_iter().flatten() {
-                if self.agents[i].moving() {
-                    self.agents[i].normals.push(n);
+            for (i, n, o) in normals.into_iter().flatten() {
+                if self.agents[i].moving() && (fresh || heading_in(&self.agents[i], n, o)) {
+                    if !fresh {
+                        self.stats.presses += 1;
+                    }
+                    self.agents[i].normals.push((n, o));
                 }
             }
         }

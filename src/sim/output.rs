@@ -112,6 +112,8 @@ pub fn world_json(world: &World) -> Value {
             "stop_rate": s.stop_rate,
             "mean_stop_duration": s.mean_stop_duration,
             "comm_radius": s.comm_radius,
+            "wall_following": s.wall_following,
+            "wall_following_length": s.wall_following_length,
             "placement": placement,
         },
         "leader": {
@@ -181,6 +183,8 @@ pub fn meta_json(world: &World, out: &SimOutput) -> Vec<u8> {
             "landmark_releases_outside": st.landmark_releases_outside,
             "landmark_releases_surplus": st.landmark_releases_surplus,
             "collisions": st.collisions,
+            "wall_follows": st.wall_follows,
+            "presses": st.presses,
         },
         "timings": {
             "wall_time_s": st.wall_time_s,

@@ -109,6 +109,11 @@ pub struct SimStats {
     pub landmark_releases_surplus: usize,
     /// Contacts (agent–agent or agent–obstacle) that triggered a new heading.
     pub collisions: usize,
+    /// Wall hits that started wall following (`swarm.wall_following`).
+    pub wall_follows: usize,
+    /// Continuing touches that counted as a new collision because the agent was heading
+    /// into them (turned there by another contact or by the end of a run).
+    pub presses: usize,
     /// Wall time of the whole run, seconds (not deterministic).
     pub wall_time_s: f64,
     /// Wall time inside the Rapier step, seconds (not deterministic).

@@ -68,7 +68,8 @@ const CONTACT_RECYCLE_DISTANCE: f32 = 5e-4;
 /// Fastest penetration recovery, m/s.
 const MAX_CORRECTIVE_VELOCITY: f32 = 0.1;
 
-/// Obstacle index that stands for the arena's sides.
+/// Obstacle index of the arena's first side; side `j` (left, right, bottom, top) is
+/// `SIDES - j`.
 pub(crate) const SIDES: u32 = u32::MAX;
 
 /// A raw event, decoded from collider handles to agent indices.
@@ -80,7 +81,7 @@ pub(crate) enum RawEvent {
     /// (`started`) or left it.
     AgentContact { a: u32, b: u32, started: bool },
     /// Agent `a` came within the prediction distance of obstacle `obstacle` (an index into
-    /// `World::obstacles`; [`SIDES`] for the arena's sides) or left it.
+    /// `World::obstacles`; `SIDES - j` for side `j` of the arena) or left it.
     ObstacleContact {
         a: u32,
         obstacle: u32,
@@ -244,13 +245,15 @@ impl Scene {
             (-t / 2.0, h / 2.0, t / 2.0, h / 2.0 + t),
             (w + t / 2.0, h / 2.0, t / 2.0, h / 2.0 + t),
         ];
-        for (cx, cy, hx, hy) in sides {
+        // Each side its own index below SIDES, in the order of the engine's `side_gaps`
+        // (left, right, bottom, top), so that touching one side is tracked apart from another.
+        for ((cx, cy, hx, hy), j) in sides.into_iter().zip([2u32, 3, 0, 1]) {
             colliders.insert_with_parent(
                 ColliderBuilder::cuboid(hx, hy)
                     .translation(Vector::new(cx, cy))
                     .collision_groups(obstacle_groups)
                     .friction(0.0)
-                    .user_data(KIND_OBSTACLE | u128::from(SIDES)),
+                    .user_data(KIND_OBSTACLE | u128::from(SIDES - j)),
                 fixed,
                 &mut bodies,
             );

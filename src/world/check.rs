@@ -440,6 +440,24 @@ impl WorldSpec {
             "metres",
             "give a positive communication radius, e.g. 1.0",
         )?;
+        let wall_following = ctx.finite(
+            "swarm.wall_following",
+            s.wall_following.unwrap_or(d.wall_following),
+            "use a probability in [0, 1], e.g. 0.5",
+        )?;
+        if !(0.0..=1.0).contains(&wall_following) {
+            return Err(ctx.err(
+                "swarm.wall_following",
+                format!("is {wall_following} (must be a probability in [0, 1])"),
+                "use 0 for the paper's pure random walk, 1 to follow every wall hit, or a value between",
+            ));
+        }
+        let wall_following_length = ctx.positive(
+            "swarm.wall_following_length",
+            s.wall_following_length.unwrap_or(d.wall_following_length),
+            "metres",
+            "give a positive mean length followed along a wall, e.g. 1.0",
+        )?;
         let placement = match s.placement.clone() {
             None => d.placement.clone(),
             Some(PlacementSpec::Window) => Placement::Window,
@@ -462,6 +480,8 @@ impl WorldSpec {
             stop_rate,
             mean_stop_duration,
             comm_radius,
+            wall_following,
+            wall_following_length,
             placement,
         };
 

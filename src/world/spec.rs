@@ -67,6 +67,8 @@ pub struct SwarmSpec {
     pub stop_rate: Option<f64>,
     pub mean_stop_duration: Option<f64>,
     pub comm_radius: Option<f64>,
+    pub wall_following: Option<f64>,
+    pub wall_following_length: Option<f64>,
     pub placement: Option<PlacementSpec>,
 }
 
@@ -243,6 +245,8 @@ pub const SETTING_PATHS: &[&str] = &[
     "swarm.stop_rate",
     "swarm.mean_stop_duration",
     "swarm.comm_radius",
+    "swarm.wall_following",
+    "swarm.wall_following_length",
     "swarm.placement",
     "leader",
     "leader.speed",
@@ -342,6 +346,8 @@ impl WorldSpec {
                             "stop_rate" => put(&mut s.stop_rate, p, v)?,
                             "mean_stop_duration" => put(&mut s.mean_stop_duration, p, v)?,
                             "comm_radius" => put(&mut s.comm_radius, p, v)?,
+                            "wall_following" => put(&mut s.wall_following, p, v)?,
+                            "wall_following_length" => put(&mut s.wall_following_length, p, v)?,
                             "placement" => put(&mut s.placement, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }

@@ -64,6 +64,13 @@ pub struct SwarmParams {
     /// Communication radius in metres used for the hop graph of landmark selection
     /// (default: `1.0`).
     pub comm_radius: f64,
+    /// Probability that a walking agent's collision with an obstacle or the arena's side
+    /// starts wall following instead of a turn (default: `0.0`, the paper's pure random
+    /// walk; the cockroach model it cites has both, Jeanson et al. 2003).
+    pub wall_following: f64,
+    /// Mean length followed along a wall before the agent turns away, metres
+    /// (exponentially distributed; default: `1.0`).
+    pub wall_following_length: f64,
     /// Initial placement (default: `Disk(radius: 1.0)`).
     pub placement: Placement,
 }
@@ -80,6 +87,8 @@ impl Default for SwarmParams {
             stop_rate: 0.01,
             mean_stop_duration: 5.0,
             comm_radius: 1.0,
+            wall_following: 0.0,
+            wall_following_length: 1.0,
             placement: Placement::Disk { radius: 1.0 },
         }
     }
