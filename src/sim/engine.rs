@@ -45,6 +45,16 @@ const PRESS_EPS: f64 = 1e-9;
 /// (pushed off, or round a corner too sharp to hug) and turns away.
 const FOLLOW_LOST: f64 = 3.0;
 
+/// A wall follower that moved less than this share of a step in each of two consecutive
+/// steps is stuck (a nook it cannot turn) and turns away.
+const FOLLOW_STUCK: f64 = 0.25;
+
+/// Step of the central differences that give a followed wall's normal, metres: well
+/// above the f32 spacing of the positions, so that in a concave nook of one polygon,
+/// where the body touches two edges, the normal is their mean and the follower slides out
+/// along the second edge instead of pressing into it.
+const FOLLOW_NORMAL_STEP: f64 = 1e-4;
+
 type P = (f64, f64);
 
 /// What an agent's body can touch.
@@ -70,6 +80,10 @@ struct Follow {
     sense: f64,
     /// Started at this step (counted once in the statistics).
     fresh: bool,
+    /// Position at the previous step, to tell a follower that makes no progress.
+    last: P,
+    /// Consecutive steps without progress.
+    stalls: u8,
 }
 
 struct Agent {
@@ -84,7 +98,8 @@ struct Agent {
     static_since: f64,
     /// End of the current pause, seconds.
     pause_until: f64,
-    /// Outward normals of the contacts that started at the last step, with what was touched.
+    /// Outward normals of the contacts of the last step (new touches, and touches the
+    /// agent heads into), with what was touched.
     normals: Vec<(P, Other)>,
     /// The wall being followed, if any (`swarm.wall_following`).
     follow: Option<Follow>,
@@ -213,7 +228,15 @@ impl Agent {
             return false;
         }
         if let Some(f) = &mut self.follow {
-            if let Some(&(_, o)) = self.normals.iter().find(|(_, o)| *o != f.wall) {
+            // A different wall ahead (a concave corner) is followed on; one beside or
+            // behind (a graze in a narrow passage) is not, or the follower would reverse.
+            let ahead = wall_geometry(world, f.wall, p).map(|(_, n)| tangent(n, f.sense));
+            if let Some(t) = ahead
+                && let Some(&(_, o)) = self
+                    .normals
+                    .iter()
+                    .find(|(m, o)| *o != f.wall && t.0 * m.0 + t.1 * m.1 < 0.0)
+            {
                 f.wall = o;
             }
             return true;
@@ -235,6 +258,8 @@ impl Agent {
             wall,
             sense,
             fresh: true,
+            last: p,
+            stalls: 0,
         });
         self.run_left = exponential(&mut self.rng, world.swarm.wall_following_length);
         true
@@ -247,7 +272,11 @@ impl Agent {
 
 /// Outward unit normal of a signed distance `f` at `p`, by central differences.
 fn gradient(f: impl Fn(P) -> f64, p: P) -> Option<P> {
-    let h = 1e-6;
+    gradient_step(f, p, 1e-6)
+}
+
+/// [`gradient`] with central differences of step `h`.
+fn gradient_step(f: impl Fn(P) -> f64, p: P, h: f64) -> Option<P> {
     let gx = f((p.0 + h, p.1)) - f((p.0 - h, p.1));
     let gy = f((p.0, p.1 + h)) - f((p.0, p.1 - h));
     let len = gx.hypot(gy);
@@ -259,9 +288,9 @@ fn tangent(n: P, sense: f64) -> P {
     (-sense * n.1, sense * n.0)
 }
 
-/// The heading of a wall follower: along the wall's tangent, turned towards the wall by
-/// enough to close a `gap` in one `step` (up to 45°), so that it stays in contact round
-/// convex corners and curves; the physics stops it at contact.
+/// The heading of a wall follower: along the wall's tangent, turned towards the wall in
+/// proportion to its `gap` (by up to 45° once the gap reaches a `step`), so that it stays
+/// in contact round convex corners and curves; the physics stops it at contact.
 fn follow_heading(n: P, sense: f64, gap: f64, step: f64) -> P {
     let t = tangent(n, sense);
     let c = (gap / step).clamp(0.0, 1.0);
@@ -277,7 +306,7 @@ fn wall_geometry(world: &World, wall: Other, p: P) -> Option<(f64, P)> {
     match wall {
         Other::Obstacle(k) => {
             let o = world.obstacles.get(k as usize)?;
-            let n = gradient(|q| o.signed_distance(q), p)?;
+            let n = gradient_step(|q| o.signed_distance(q), p, FOLLOW_NORMAL_STEP)?;
             Some((o.signed_distance(p) - r, n))
         }
         Other::Side(j) => side_gaps(world, p, r).get(usize::from(j)).copied(),
@@ -299,13 +328,14 @@ fn side_gaps(world: &World, p: P, r: f64) -> [(f64, P); 4] {
 
 fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
     let s = &world.swarm;
-    let positive: [(&'static str, f64); 9] = [
+    let positive: [(&'static str, f64); 10] = [
         ("simulation.dt", world.simulation.dt),
         ("swarm.detection_radius", s.detection_radius),
         ("swarm.body_radius", s.body_radius),
         ("swarm.mean_run_length", s.mean_run_length),
         ("swarm.mean_stop_duration", s.mean_stop_duration),
         ("swarm.comm_radius", s.comm_radius),
+        ("swarm.wall_following_length", s.wall_following_length),
         ("leader.speed", world.leader.speed),
         ("arena.width", world.arena.width),
         ("arena.height", world.arena.height),
@@ -335,6 +365,13 @@ fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
                 expected: "expected a finite number, 0 or more",
             });
         }
+    }
+    if !(0.0..=1.0).contains(&s.wall_following) {
+        return Err(SimError::InvalidWorld {
+            field: "swarm.wall_following",
+            value: s.wall_following,
+            expected: "expected a probability between 0 and 1",
+        });
     }
     if !(0.0..=1.0).contains(&s.landmark_fraction) {
         return Err(SimError::InvalidWorld {
@@ -424,6 +461,10 @@ impl Run<'_> {
         let a = &mut self.agents[i];
         if !a.moving() {
             a.normals.clear();
+            if let Some(f) = &mut a.follow {
+                // A pause keeps the follow; progress is measured from where it resumes.
+                f.last = p;
+            }
             return;
         }
         if !inside && a.state == AgentState::Walk {
@@ -448,16 +489,27 @@ impl Run<'_> {
             a.normals.clear();
         }
         if let Some(f) = &mut a.follow {
-            f.fresh = false;
-            let f = *f;
             let step = world.swarm.speed * world.simulation.dt;
+            let moved = (p.0 - f.last.0).hypot(p.1 - f.last.1);
+            f.stalls = if !f.fresh && moved < FOLLOW_STUCK * step {
+                f.stalls.saturating_add(1)
+            } else {
+                0
+            };
+            // One short step is normal (arriving in a corner, before the next wall is
+            // taken on); two in a row is a nook the follower cannot turn.
+            let stuck = f.stalls >= 2;
+            f.fresh = false;
+            f.last = p;
+            let f = *f;
             match wall_geometry(world, f.wall, p) {
-                Some((gap, n)) if a.run_left > 0.0 && gap <= FOLLOW_LOST * step => {
+                Some((gap, n)) if a.run_left > 0.0 && gap <= FOLLOW_LOST * step && !stuck => {
                     a.heading = follow_heading(n, f.sense, gap, step);
                 }
                 wall => {
-                    // The followed length is spent (or the wall was lost): turn away from
-                    // the wall and start a new random-walk run.
+                    // The followed length is spent, the wall was lost, or the follower
+                    // made no progress (a nook it cannot turn): turn away from the wall
+                    // and start a new random-walk run.
                     a.follow = None;
                     if let Some((_, n)) = wall {
                         a.normals.push((n, f.wall));
@@ -577,8 +629,9 @@ impl Run<'_> {
     }
 
     /// Finds the near pairs whose bodies have just come to touch at `pos` and gives each
-    /// moving agent involved the outward normal of the contact, from the exact geometry.
-    /// Normals are only computed for a new touch: the gap alone decides the rest.
+    /// moving agent involved the outward normal of the contact, from the exact geometry;
+    /// likewise for a continuing touch that a moving agent heads into (a press), except a
+    /// follower's own wall. Otherwise normals are not computed: the gap alone decides.
     fn detect_touches(&mut self, pos: &[P]) {
         let world = self.world;
         let r = world.swarm.body_radius;
@@ -827,4 +880,26 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         trajectories: traj,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_wall_following_draws_no_random_number() {
+        // The paper's random walk must keep its exact sequence of draws when wall
+        // following is off: a wall hit is then a plain turn, decided without the rng.
+        let mut world = World::empty("w", 4.0, 4.0);
+        world.swarm.wall_following = 0.0;
+        let mut a = Agent::new(3, 0, &world);
+        a.normals.push(((0.0, 1.0), Other::Side(2)));
+        let before = a.rng.clone();
+        assert!(!a.wall_contact(&world, (1.0, 0.004)));
+        assert_eq!(*a.rng, *before);
+        // With a positive probability the same hit draws.
+        world.swarm.wall_following = 0.5;
+        let _ = a.wall_contact(&world, (1.0, 0.004));
+        assert_ne!(*a.rng, *before);
+    }
 }

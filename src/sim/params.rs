@@ -107,12 +107,14 @@ pub struct SimStats {
     pub landmark_releases_outside: usize,
     /// Landmarks released because fewer agents were inside D(t).
     pub landmark_releases_surplus: usize,
-    /// Contacts (agent–agent or agent–obstacle) that triggered a new heading.
+    /// Contacts (agent–agent, agent–obstacle or agent–side, presses included) that
+    /// triggered a new heading.
     pub collisions: usize,
     /// Wall hits that started wall following (`swarm.wall_following`).
     pub wall_follows: usize,
-    /// Continuing touches that counted as a new collision because the agent was heading
-    /// into them (turned there by another contact or by the end of a run).
+    /// Continuing touches reported again because the agent was heading into them (turned
+    /// there by another contact, the end of a run or a landmark's release): a turn, or
+    /// under wall following the start or switch of a follow.
     pub presses: usize,
     /// Wall time of the whole run, seconds (not deterministic).
     pub wall_time_s: f64,
