@@ -660,19 +660,20 @@ impl Run<'_> {
             }
             let fresh = !std::mem::replace(touching, true);
             // A continuing touch matters only to a moving agent heading into it (turned
-            // there by another contact or a run's end): skip the normals otherwise.
-            // (A follower steers into its own wall on purpose.)
-            let heading_in = |ag: &Agent, n: P, o: Other| {
-                ag.moving()
-                    && ag.heading.0 * n.0 + ag.heading.1 * n.1 < -PRESS_EPS
-                    && ag.follow.is_none_or(|f| f.wall != o)
-            };
+            // there by another contact or a run's end): skip the normals otherwise. A
+            // follower steers into its own wall on purpose, so that touch is skipped too
+            // (its normal is computed where it steers).
+            let heading_in =
+                |ag: &Agent, n: P| ag.heading.0 * n.0 + ag.heading.1 * n.1 < -PRESS_EPS;
             if !fresh {
                 let idle = match other {
                     Other::Agent(b) => {
                         !self.agents[a as usize].moving() && !self.agents[b as usize].moving()
                     }
-                    _ => !self.agents[a as usize].moving(),
+                    wall => {
+                        let ag = &self.agents[a as usize];
+                        !ag.moving() || ag.follow.is_some_and(|f| f.wall == wall)
+                    }
                 };
                 if idle {
                     continue;
@@ -703,7 +704,7 @@ impl Run<'_> {
                 }
             }
             for (i, n, o) in normals.into_iter().flatten() {
-                if self.agents[i].moving() && (fresh || heading_in(&self.agents[i], n, o)) {
+                if self.agents[i].moving() && (fresh || heading_in(&self.agents[i], n)) {
                     if !fresh {
                         self.stats.presses += 1;
                     }
