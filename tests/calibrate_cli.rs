@@ -75,3 +75,40 @@ fn a_bad_model_file_is_an_input_error_naming_it() {
         .code(2)
         .stderr(contains("is not a model file"));
 }
+
+#[test]
+fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    std::fs::write(&out, SHIPPED).unwrap();
+    let assert = Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args(["calibrate", WORLD, "--seeds", "1,2", "--jobs", "1"])
+        .args(["--cross-validate", "seeds", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("held out by seed: 2 folds"))
+        .stdout(contains("without seed 1 "))
+        .stdout(contains("without seed 2 "));
+    let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
+    // Each fold judges the 2 windows of its seed.
+    assert_eq!(stdout.matches("right, false holes").count(), 2, "{stdout}");
+    assert!(stdout.contains("/2 right"), "{stdout}");
+    let m = models(&out);
+    assert!(
+        m.paper.fitted_on.contains("; held out by seed: "),
+        "{}",
+        m.paper.fitted_on
+    );
+
+    // One training world cannot be held out against the others.
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args(["calibrate", WORLD, "--seeds", "1,2", "--jobs", "1"])
+        .args(["--cross-validate", "worlds", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains("at least two groups"));
+}

@@ -3,10 +3,10 @@
 
 use super::{Failure, input, load_world};
 use anyhow::{Context, anyhow};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use std::path::PathBuf;
-use swarmmap::eval::calibrate::{Sample, fit};
+use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit};
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::Models;
@@ -41,6 +41,20 @@ pub struct CalibrateArgs {
     /// may report one; accuracy is maximised under this constraint (`1` = unconstrained).
     #[arg(long, default_value_t = swarmmap::eval::calibrate::MAX_FALSE_HOLES)]
     pub max_false_holes: f64,
+    /// Also estimate the fit's accuracy on windows it was not fitted on: hold out each seed
+    /// (or each world) in turn, fit on the rest under the same cap, judge the held-out
+    /// windows. Repeat the option for both. The model written is still the fit on all.
+    #[arg(long = "cross-validate", value_enum, value_name = "GROUPS")]
+    pub cross_validate: Vec<CvGroups>,
+}
+
+/// How `--cross-validate` groups the training windows into folds.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CvGroups {
+    /// One fold per seed: new runs of the same worlds.
+    Seeds,
+    /// One fold per training world: layouts the fit has never seen.
+    Worlds,
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
@@ -78,7 +92,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         .build()
         .map_err(|e| Failure::Other(e.into()))?;
     let oracle = args.oracle;
-    let results: Vec<Result<(Target, Vec<Sample>), String>> = pool.install(|| {
+    type Job = (Target, Vec<Sample>, String, u64);
+    let results: Vec<Result<Job, String>> = pool.install(|| {
         jobs.par_iter()
             .map(|&(world, seed)| {
                 let out = simulate(world, &SimOptions::new(seed))
@@ -110,7 +125,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 } else {
                     Target::Method(world.mapping.method)
                 };
-                Ok((target, samples))
+                Ok((target, samples, world.name.clone(), seed))
             })
             .collect()
     });
@@ -120,16 +135,29 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             .map_err(input)?,
         Err(_) => Models::shipped(),
     };
-    let mut by_method: Vec<(Target, Vec<Sample>)> = Vec::new();
+    let mut by_method: Vec<Training> = Vec::new();
     for r in results {
-        let (method, samples) = r.map_err(|e| Failure::Other(anyhow!(e)))?;
-        match by_method.iter_mut().find(|(m, _)| *m == method) {
-            Some((_, v)) => v.extend(samples),
-            None => by_method.push((method, samples)),
+        let (target, samples, world, seed) = r.map_err(|e| Failure::Other(anyhow!(e)))?;
+        let origin = vec![(world, seed); samples.len()];
+        match by_method.iter_mut().find(|t| t.target == target) {
+            Some(t) => {
+                t.samples.extend(samples);
+                t.origin.extend(origin);
+            }
+            None => by_method.push(Training {
+                target,
+                samples,
+                origin,
+            }),
         }
     }
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-    for (method, samples) in &by_method {
+    for Training {
+        target: method,
+        samples,
+        origin,
+    } in &by_method
+    {
         let f = fit(samples, args.max_false_holes).ok_or_else(|| {
             input(anyhow!(
                 "no classifier shows false holes in at most {} of the {} training windows \
@@ -154,16 +182,48 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         );
+        let mut held_out = String::new();
+        for &groups in &args.cross_validate {
+            let labels: Vec<String> = origin
+                .iter()
+                .map(|(world, seed)| match groups {
+                    CvGroups::Seeds => format!("seed {seed}"),
+                    CvGroups::Worlds => world.clone(),
+                })
+                .collect();
+            let cv = cross_validate(samples, &labels, args.max_false_holes)
+                .map_err(|e| input(anyhow!(e)))?;
+            print_cross_validation(groups, &cv);
+            held_out.push_str(&format!(
+                "; held out by {}: {:.1} % right, false holes in {:.1} %",
+                match groups {
+                    CvGroups::Seeds => "seed",
+                    CvGroups::Worlds => "world",
+                },
+                100.0 * cv.accuracy,
+                100.0 * cv.false_holes
+            ));
+        }
         let m = match method {
             Target::Method(method) => models.get_mut(*method),
             Target::Oracle => &mut models.oracle,
         };
         m.classifier = f.classifier;
         m.fitted_on = format!(
-            "swarmmap calibrate{} --seeds {} --max-false-holes {} {}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
+            "swarmmap calibrate{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
             if oracle { " --oracle" } else { "" },
             args.seeds,
             args.max_false_holes,
+            args.cross_validate
+                .iter()
+                .map(|g| format!(
+                    "--cross-validate {} ",
+                    match g {
+                        CvGroups::Seeds => "seeds",
+                        CvGroups::Worlds => "worlds",
+                    }
+                ))
+                .collect::<String>(),
             args.set
                 .iter()
                 .map(|s| format!("--set {s} "))
@@ -174,7 +234,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b0_accuracy,
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
-        );
+        ) + &held_out;
     }
     let mut text = serde_json::to_string_pretty(&models).map_err(|e| Failure::Other(e.into()))?;
     text.push('\n');
@@ -185,6 +245,53 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Prints a cross-validation: the pooled held-out figures, then one line per fold.
+fn print_cross_validation(groups: CvGroups, cv: &CrossValidation) {
+    let (lo, hi) = cv
+        .folds
+        .iter()
+        .map(|f| f.right as f64 / f.windows as f64)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+    println!(
+        "  held out by {}: {} folds, each judged by the model fitted on the others: {:.1} % of \
+         {} windows right (folds {:.1}–{:.1} %), false holes in {:.1} % of {} hole-free windows",
+        match groups {
+            CvGroups::Seeds => "seed",
+            CvGroups::Worlds => "world",
+        },
+        cv.folds.len(),
+        100.0 * cv.accuracy,
+        cv.windows,
+        100.0 * lo,
+        100.0 * hi,
+        100.0 * cv.false_holes,
+        cv.holeless
+    );
+    for f in &cv.folds {
+        println!(
+            "    without {:<12} h1_ratio {:.2}, h1_span {:.2}, h0_ratio {:.2}: {}/{} right, false holes {}/{}",
+            f.held_out,
+            f.classifier.h1_ratio,
+            f.classifier.h1_span,
+            f.classifier.h0_ratio,
+            f.right,
+            f.windows,
+            f.false_holes,
+            f.holeless
+        );
+    }
+}
+
+/// The training windows of one fitted target, with each sample's (world, seed) for
+/// cross-validation.
+struct Training {
+    target: Target,
+    samples: Vec<Sample>,
+    origin: Vec<(String, u64)>,
 }
 
 /// What a fit is for: a mapping method's model, or the truth-position oracle's.

@@ -77,10 +77,13 @@ pub struct Fit {
 /// Default of [`fit`]'s `max_false_holes`.
 pub const MAX_FALSE_HOLES: f64 = 0.02;
 
-/// The grid of each threshold.
+/// The grid of each threshold, its points rounded to 10⁻⁹ so that the model file reads
+/// `3.8`, not `3.8000000000000003`.
 fn grid(lo: f64, hi: f64, step: f64) -> Vec<f64> {
     let n = ((hi - lo) / step).round() as usize;
-    (0..=n).map(|k| lo + k as f64 * step).collect()
+    (0..=n)
+        .map(|k| ((lo + k as f64 * step) * 1e9).round() / 1e9)
+        .collect()
 }
 
 /// Fits the three thresholds on `samples`. β0 and β1 are decided by disjoint parameters
@@ -92,13 +95,17 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
     if samples.is_empty() {
         return None;
     }
-    // Precompute the sampling scale of each component once.
-    let scaled: Vec<Vec<(f64, &Vec<Feature>)>> = samples
+    // Precompute each component's sampling scale and split its features by dimension once:
+    // the grid search below judges every sample at every grid point.
+    let scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>> = samples
         .iter()
         .map(|s| {
             s.components
                 .iter()
-                .map(|f| (sampling_scale(f), f))
+                .map(|f| {
+                    let by_dim = |d: usize| f.iter().filter(|x| x.dim == d).copied().collect();
+                    (sampling_scale(f), [by_dim(0), by_dim(1)])
+                })
                 .collect()
         })
         .collect();
@@ -109,11 +116,7 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
             .filter(|(s, comps)| {
                 let b: usize = comps
                     .iter()
-                    .map(|(sigma, fs)| {
-                        fs.iter()
-                            .filter(|f| f.dim == dim && pick(f, *sigma))
-                            .count()
-                    })
+                    .map(|(sigma, fs)| fs[dim].iter().filter(|f| pick(f, *sigma)).count())
                     .sum();
                 b == s.truth[dim]
             })
@@ -152,7 +155,7 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
             .filter(|&&k| {
                 scaled[k]
                     .iter()
-                    .any(|(sigma, fs)| fs.iter().any(|f| f.dim == 1 && c.robust(f, *sigma)))
+                    .any(|(sigma, fs)| fs[1].iter().any(|f| c.robust(f, *sigma)))
             })
             .count();
         shown as f64 / holeless.len() as f64
@@ -194,6 +197,113 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
         b1_accuracy: ok1 as f64 / n,
         windows: samples.len(),
         false_holes: false_share(&classifier),
+    })
+}
+
+/// One fold of a cross-validation: the model fitted without one group of training windows,
+/// judged on that group.
+#[derive(Debug, Clone, Serialize)]
+pub struct Fold {
+    /// The group held out (a seed or a world).
+    pub held_out: String,
+    /// The model fitted on the other groups.
+    pub classifier: Classifier,
+    /// Held-out windows, and how many of them the model gets right (both Betti numbers).
+    pub windows: usize,
+    pub right: usize,
+    /// Held-out windows without a true hole, and in how many of them the model shows one.
+    pub holeless: usize,
+    pub false_holes: usize,
+}
+
+/// Held-out estimates of a fit's accuracy ([`cross_validate`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct CrossValidation {
+    pub folds: Vec<Fold>,
+    /// Share of all windows right when each is judged by the model fitted without its group.
+    pub accuracy: f64,
+    /// Share of the hole-free windows in which that model shows a hole.
+    pub false_holes: f64,
+    pub windows: usize,
+    pub holeless: usize,
+}
+
+/// Leave-one-group-out cross-validation of [`fit`]: for every group (in order of first
+/// appearance in `groups`, one label per sample), fit on the samples of the other groups
+/// under the same false-hole cap and judge the held-out samples. Grouping by seed says how
+/// well the thresholds carry to new runs of the same worlds; grouping by world, to layouts
+/// the fit has never seen (the position of the evaluation scenarios). In-sample accuracy
+/// overstates both: the grid search picks the thresholds that suit its own windows.
+///
+/// Errors if there are fewer than two groups, or if some fold has no classifier within the
+/// cap.
+pub fn cross_validate(
+    samples: &[Sample],
+    groups: &[String],
+    max_false_holes: f64,
+) -> Result<CrossValidation, String> {
+    assert_eq!(samples.len(), groups.len(), "one group label per sample");
+    let mut labels: Vec<&String> = Vec::new();
+    for g in groups {
+        if !labels.contains(&g) {
+            labels.push(g);
+        }
+    }
+    if labels.len() < 2 {
+        return Err(format!(
+            "cross-validation needs at least two groups of training windows, got {}",
+            labels.len()
+        ));
+    }
+    let mut folds = Vec::with_capacity(labels.len());
+    for label in labels {
+        let in_fold = |k: &usize| groups[*k] == *label;
+        let held: Vec<&Sample> = (0..samples.len())
+            .filter(in_fold)
+            .map(|k| &samples[k])
+            .collect();
+        let train: Vec<Sample> = (0..samples.len())
+            .filter(|k| !in_fold(k))
+            .map(|k| samples[k].clone())
+            .collect();
+        let f = fit(&train, max_false_holes).ok_or_else(|| {
+            format!(
+                "without {label}, no classifier shows false holes in at most {max_false_holes} \
+                 of the training windows without a hole"
+            )
+        })?;
+        let mut fold = Fold {
+            held_out: label.clone(),
+            classifier: f.classifier,
+            windows: held.len(),
+            right: 0,
+            holeless: 0,
+            false_holes: 0,
+        };
+        for s in held {
+            let b = s.betti(&f.classifier);
+            fold.right += usize::from(b == s.truth);
+            if s.truth[1] == 0 {
+                fold.holeless += 1;
+                fold.false_holes += usize::from(b[1] > 0);
+            }
+        }
+        folds.push(fold);
+    }
+    let windows: usize = folds.iter().map(|f| f.windows).sum();
+    let holeless: usize = folds.iter().map(|f| f.holeless).sum();
+    let right: usize = folds.iter().map(|f| f.right).sum();
+    let shown: usize = folds.iter().map(|f| f.false_holes).sum();
+    Ok(CrossValidation {
+        accuracy: right as f64 / windows as f64,
+        false_holes: if holeless == 0 {
+            0.0
+        } else {
+            shown as f64 / holeless as f64
+        },
+        windows,
+        holeless,
+        folds,
     })
 }
 
@@ -278,5 +388,74 @@ mod tests {
         for s in &samples[2..] {
             assert_eq!(s.betti(&strict.classifier)[1], 0);
         }
+    }
+    /// Two groups whose noise and signal overlap across groups (group A: hole ratio 3,
+    /// noise 2; group B: hole 5, noise 3.5). Each group alone is separable, so the in-sample
+    /// fit on both gets 3 of 4 windows right; held out, each group is judged by thresholds
+    /// fitted on the other: B's noise loop passes A's thresholds (a false hole) and A's hole
+    /// fails B's, so exactly 2 of 4 windows are right and 1 of the 2 hole-free ones shows a
+    /// hole (worked out by hand for every point of each fold's best plateau).
+    #[test]
+    fn cross_validation_judges_each_group_by_the_others_fit() {
+        let window = |birth: f64, death: f64, truth: usize| {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            v.push(f(1, birth, death));
+            Sample {
+                components: vec![v],
+                truth: [1, truth],
+            }
+        };
+        let samples = vec![
+            window(1.0, 3.0, 1),
+            window(1.0, 2.0, 0),
+            window(1.0, 5.0, 1),
+            window(1.0, 3.5, 0),
+        ];
+        let groups: Vec<String> = ["A", "A", "B", "B"].map(String::from).to_vec();
+        let all = fit(&samples, 1.0).unwrap();
+        assert_eq!(all.accuracy, 0.75, "{all:?}");
+        let cv = cross_validate(&samples, &groups, 1.0).unwrap();
+        assert_eq!(cv.folds.len(), 2);
+        assert_eq!(cv.folds[0].held_out, "A");
+        assert_eq!(
+            (cv.folds[0].right, cv.folds[0].false_holes),
+            (1, 0),
+            "{cv:?}"
+        );
+        assert_eq!(
+            (cv.folds[1].right, cv.folds[1].false_holes),
+            (1, 1),
+            "{cv:?}"
+        );
+        assert_eq!((cv.accuracy, cv.false_holes), (0.5, 0.5));
+        assert_eq!((cv.windows, cv.holeless), (4, 2));
+    }
+
+    /// Copies of one separable group: every fold's model separates the held-out copy too.
+    #[test]
+    fn cross_validation_of_consistent_groups_is_exact() {
+        let window = |death: f64, truth: usize| {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            v.push(f(1, 1.0, 1.6));
+            v.push(f(1, 1.0, death));
+            Sample {
+                components: vec![v],
+                truth: [1, truth],
+            }
+        };
+        let mut samples = Vec::new();
+        let mut groups = Vec::new();
+        for g in 0..3 {
+            samples.push(window(6.0, 1));
+            samples.push(window(1.8, 0));
+            groups.extend([format!("seed {g}"), format!("seed {g}")]);
+        }
+        let cv = cross_validate(&samples, &groups, 0.0).unwrap();
+        assert_eq!(cv.folds.len(), 3);
+        assert_eq!((cv.accuracy, cv.false_holes), (1.0, 0.0), "{cv:?}");
+        let one = cross_validate(&samples[..2], &groups[..2], 0.0);
+        assert!(one.unwrap_err().contains("at least two groups"));
     }
 }
