@@ -57,6 +57,24 @@ pub enum CvGroups {
     Worlds,
 }
 
+impl CvGroups {
+    /// What one fold holds out, in the printed figures.
+    fn noun(self) -> &'static str {
+        match self {
+            CvGroups::Seeds => "seed",
+            CvGroups::Worlds => "world",
+        }
+    }
+
+    /// The option's value, as written on the command line.
+    fn value(self) -> &'static str {
+        match self {
+            CvGroups::Seeds => "seeds",
+            CvGroups::Worlds => "worlds",
+        }
+    }
+}
+
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     let seeds = super::eval::parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
     let mut paths = args.worlds.clone();
@@ -196,10 +214,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             print_cross_validation(groups, &cv);
             held_out.push_str(&format!(
                 "; held out by {}: {:.1} % right, false holes in {:.1} %",
-                match groups {
-                    CvGroups::Seeds => "seed",
-                    CvGroups::Worlds => "world",
-                },
+                groups.noun(),
                 100.0 * cv.accuracy,
                 100.0 * cv.false_holes
             ));
@@ -216,13 +231,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             args.max_false_holes,
             args.cross_validate
                 .iter()
-                .map(|g| format!(
-                    "--cross-validate {} ",
-                    match g {
-                        CvGroups::Seeds => "seeds",
-                        CvGroups::Worlds => "worlds",
-                    }
-                ))
+                .map(|g| format!("--cross-validate {} ", g.value()))
                 .collect::<String>(),
             args.set
                 .iter()
@@ -259,10 +268,7 @@ fn print_cross_validation(groups: CvGroups, cv: &CrossValidation) {
     println!(
         "  held out by {}: {} folds, each judged by the model fitted on the others: {:.1} % of \
          {} windows right (folds {:.1}–{:.1} %), false holes in {:.1} % of {} hole-free windows",
-        match groups {
-            CvGroups::Seeds => "seed",
-            CvGroups::Worlds => "world",
-        },
+        groups.noun(),
         cv.folds.len(),
         100.0 * cv.accuracy,
         cv.windows,
