@@ -62,17 +62,17 @@ fn run_writes_every_output_and_is_deterministic() {
     assert_eq!(summary_without_timings(&a), summary_without_timings(&b));
 }
 
-#[test]
-fn a_log_without_truth_or_world_maps_without_truth() {
-    let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("run");
+/// A simulated log stripped to what a real experiment would record: `encounters.csv`
+/// without truth columns and `static_intervals.csv`, no metadata.
+fn real_log(tmp: &Path) -> std::path::PathBuf {
+    let run = tmp.join("run");
     swarmmap()
         .args(["simulate", TINY, "--quiet", "--out"])
         .arg(&run)
         .assert()
         .success();
     // Strip the truth columns and the metadata: what a real experiment would record.
-    let log = tmp.path().join("log");
+    let log = tmp.join("log");
     fs::create_dir_all(&log).unwrap();
     let text = fs::read_to_string(run.join("encounters.csv")).unwrap();
     let stripped: String = text
@@ -85,6 +85,13 @@ fn a_log_without_truth_or_world_maps_without_truth() {
         log.join("static_intervals.csv"),
     )
     .unwrap();
+    log
+}
+
+#[test]
+fn a_log_without_truth_or_world_maps_without_truth() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
     swarmmap()
         .args(["map", "--windows", "2", "--overlap", "30"])
         .arg(&log)
@@ -96,6 +103,58 @@ fn a_log_without_truth_or_world_maps_without_truth() {
     assert_eq!(windows.len(), 2);
     assert!(windows.iter().all(|w| w["truth"].is_null()));
     assert!(s["global"]["truth"].is_null());
+}
+
+/// `--method embedded` on a real log, with and without landmark intervals: every window
+/// keeps its component (the method falls back to all encounters where it has no landmark
+/// encounters to anchor on), and a log without landmarks is warned about, since nothing can
+/// stitch its windows.
+#[test]
+fn the_embedded_method_maps_a_log_with_or_without_landmarks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
+    let map = |log: &Path| {
+        swarmmap()
+            .args([
+                "map",
+                "--windows",
+                "2",
+                "--overlap",
+                "30",
+                "--method",
+                "embedded",
+            ])
+            .arg(log)
+            .assert()
+            .success()
+    };
+    let with = map(&log);
+    let stderr = String::from_utf8(with.get_output().stderr.clone()).unwrap();
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let s = json(&log.join("summary.json"));
+    assert!(
+        s["windows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|w| w["betti"][0] == 1),
+        "{s}"
+    );
+    assert_eq!(s["connections"][0]["count"], 1, "{s}");
+
+    fs::remove_file(log.join("static_intervals.csv")).unwrap();
+    map(&log).stderr(contains("no landmark static intervals"));
+    let s = json(&log.join("summary.json"));
+    assert!(
+        s["windows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|w| w["betti"][0] == 1),
+        "{s}"
+    );
+    assert_eq!(s["connections"][0]["count"], 0, "{s}");
+    assert_eq!(s["global"]["betti"][0], 2, "{s}");
 }
 
 #[test]

@@ -6,11 +6,12 @@ use super::{Failure, input, load_world};
 use clap::Args;
 use std::path::PathBuf;
 use swarmmap::log::EncounterLog;
+use swarmmap::log::StaticReason;
 use swarmmap::mapping::local::LocalParams;
 use swarmmap::mapping::pipeline::MapConfig;
 use swarmmap::mapping::stitch::StitchParams;
 use swarmmap::pipeline::{Timings, map_log, world_from_run, write_maps};
-use swarmmap::world::MappingParams;
+use swarmmap::world::{MappingMethod, MappingParams};
 
 /// Options of `swarmmap map`.
 #[derive(Args, Debug)]
@@ -29,6 +30,27 @@ pub struct MapArgs {
     /// either, the log is mapped without ground truth.
     #[arg(long)]
     pub world: Option<PathBuf>,
+    /// Local-mapping method (default: the world's `mapping.method`, else `paper`):
+    /// `paper` (Rips on the encounter metric) or `embedded` (Rips on the plane of the
+    /// encounter point cloud, anchored on encounters with static landmarks).
+    #[arg(long, value_enum)]
+    pub method: Option<Method>,
+}
+
+/// `--method` values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    Paper,
+    Embedded,
+}
+
+impl From<Method> for MappingMethod {
+    fn from(m: Method) -> Self {
+        match m {
+            Method::Paper => MappingMethod::Paper,
+            Method::Embedded => MappingMethod::Embedded,
+        }
+    }
 }
 
 pub fn run(args: &MapArgs) -> Result<(), Failure> {
@@ -80,6 +102,26 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             )));
         }
         cfg.overlap = o;
+    }
+    if let Some(method) = args.method {
+        let mut m = world
+            .as_ref()
+            .map_or_else(MappingParams::default, |w| w.mapping.clone());
+        m.method = method.into();
+        cfg.local = LocalParams::from_mapping(&m);
+    }
+    if !log
+        .static_intervals
+        .iter()
+        .any(|s| s.reason == StaticReason::Landmark)
+    {
+        eprintln!(
+            "warning: {} has no landmark static intervals (static_intervals.csv, reason \
+             `landmark`): no static agent bridges time or stands through the windows' \
+             overlaps, so the metric is travel time alone and consecutive local maps cannot \
+             be stitched (every window is its own component of the global map)",
+            args.run_dir.display()
+        );
     }
     let mut timings = Timings::default();
     let seed = world.as_ref().map(|w| w.seed);

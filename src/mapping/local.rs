@@ -236,14 +236,19 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
     let mut rows_out = Vec::new();
     let mut explained = Vec::new();
     for members in groups.into_iter().filter(|g| g.len() >= min_size.max(3)) {
-        let candidates: Vec<usize> = if p.anchored {
+        // A component with too few encounters with landmarks (a log without landmark
+        // intervals, or a region no landmark reached) is embedded from all its encounters,
+        // as the paper's method does: dropping it would lose a real component.
+        let landmark_encounters: Vec<usize> = if p.anchored {
             members.iter().copied().filter(|&j| anchored[j]).collect()
+        } else {
+            Vec::new()
+        };
+        let candidates = if landmark_encounters.len() >= 3 {
+            landmark_encounters
         } else {
             members.clone()
         };
-        if candidates.len() < 3 {
-            continue;
-        }
         let sub = subsample(&graph, &candidates, &p.subsample);
         // Embed every member of the component from the representatives' rows.
         let rows: Vec<Vec<f64>> = sub
@@ -378,5 +383,50 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         betti,
         explained,
         rows: rows_out,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mapping::synthetic::{SyntheticParams, synthetic_log};
+    use crate::world::{MappingMethod, MappingParams};
+
+    /// The `Embedded` method anchors its cloud on encounters with landmarks. A log without
+    /// landmark intervals (a real experiment that logged none) must still map every region
+    /// of the window as a component, embedded from all its encounters, not lose it: before
+    /// the fallback, every window of such a log came out with β0 = 0.
+    #[test]
+    fn a_log_without_landmarks_keeps_its_components() {
+        let log = synthetic_log(&SyntheticParams::default(), 3000);
+        let span = log.span().unwrap();
+        let window = Window {
+            index: 1,
+            start: span.0,
+            end: span.1,
+        };
+        let params = LocalParams::from_mapping(&MappingParams {
+            method: MappingMethod::Embedded,
+            ..MappingParams::default()
+        });
+        let anchored = local_map(&log, &window, &params);
+        assert_eq!(anchored.components.len(), 1);
+        assert_eq!(anchored.betti[0], 1);
+
+        let mut bare = log.clone();
+        bare.static_intervals.clear();
+        let map = local_map(&bare, &window, &params);
+        assert_eq!(map.components.len(), 1, "the region is one component");
+        assert_eq!(map.betti[0], 1);
+        let c = &map.components[0];
+        assert!(c.representatives.len() >= 3);
+        // Every event of the component is placed, at finite coordinates off the origin
+        // where noise sits.
+        assert!(
+            c.events
+                .iter()
+                .all(|&j| !map.noise[j] && map.points[j].iter().all(|x| x.is_finite()))
+        );
+        assert!(c.events.iter().any(|&j| map.points[j] != [0.0; 3]));
     }
 }
