@@ -219,3 +219,18 @@ fn the_other_worlds_have_the_topology_their_comments_state() {
     assert_eq!(betti(&load("nonconvex"), 0.0, 30.0), (1, 2));
     assert_eq!(betti(&load("touching"), 0.0, 30.0), (1, 1));
 }
+
+/// The speed benchmarks the README's "Speed" table runs: what they simulate is what the
+/// table's real-time factors are computed from (60 s of 1 000 agents, 3 s of 10 000).
+#[test]
+fn the_speed_benchmarks_are_the_runs_the_readme_times() {
+    for (file, agents, span) in [("k1", 1_000, 60.0), ("k10", 10_000, 3.0)] {
+        let w = World::load(format!("worlds/bench/{file}.ron")).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(w.name, file);
+        assert_eq!(w.swarm.agents, agents);
+        assert_eq!(w.swarm.detection_radius, 0.01, "the paper's sensing");
+        assert_eq!(w.leader.start_x, w.leader.end_x, "no sweep");
+        assert_eq!(w.simulation.dispersion_time, span);
+        assert_eq!(w.simulation.dt, 0.03);
+    }
+}

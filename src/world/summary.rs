@@ -78,8 +78,8 @@ impl World {
         let sw = &self.swarm;
         let landmarks = landmark_count(sw.landmark_fraction, sw.agents);
         let placement = match sw.placement {
-            Placement::Disk { radius } => format!("disc of radius {radius} m"),
-            Placement::Window => "initial window".to_string(),
+            Placement::Disk { radius } => format!("a disc of radius {radius} m"),
+            Placement::Window => "the initial window".to_string(),
         };
         let raster = FreeSpaceRaster::new(self, sw.body_radius);
         let area = self.arena.width * self.arena.height;
@@ -105,7 +105,7 @@ impl World {
         );
         let _ = writeln!(
             s,
-            "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in a {}",
+            "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in {}",
             sw.agents,
             landmarks,
             100.0 * sw.landmark_fraction,
