@@ -192,6 +192,14 @@ fn csv_error(path: &Path, line: u64, e: &csv::Error) -> LogError {
     }
 }
 
+/// Largest |time| a log may hold, seconds. Far beyond any experiment, it catches unit
+/// mistakes (epoch milliseconds or nanoseconds) and corrupt values: the mapping squares
+/// time differences (classical MDS), which overflow f64 from about 1e154 s.
+pub const MAX_TIME: f64 = 1e12;
+
+/// Largest |position| a log may hold, metres (truth columns and the leader's x).
+pub const MAX_POSITION: f64 = 1e9;
+
 struct Row<'a> {
     record: &'a csv::StringRecord,
     columns: &'a Columns,
@@ -210,6 +218,30 @@ impl Row<'_> {
         if !v.is_finite() {
             return Err(format!(
                 "column `{name}` is `{s}`; times and positions must be finite numbers"
+            ));
+        }
+        Ok(v)
+    }
+
+    /// A time in seconds, within ±[`MAX_TIME`].
+    fn time(&self, name: &str) -> Result<f64, String> {
+        let v = self.f64(name)?;
+        if v.abs() > MAX_TIME {
+            return Err(format!(
+                "column `{name}` is `{}`, beyond ±1e12 s (about 31 700 years); times are seconds (milliseconds or nanoseconds since an epoch? divide by 1e3 or 1e9)",
+                self.text(name).unwrap_or("")
+            ));
+        }
+        Ok(v)
+    }
+
+    /// A position in metres, within ±[`MAX_POSITION`].
+    fn position(&self, name: &str) -> Result<f64, String> {
+        let v = self.f64(name)?;
+        if v.abs() > MAX_POSITION {
+            return Err(format!(
+                "column `{name}` is `{}`, beyond ±1e9 m; positions are metres in the arena's frame",
+                self.text(name).unwrap_or("")
             ));
         }
         Ok(v)
@@ -269,7 +301,7 @@ impl EncounterLog {
 }
 
 fn interval(row: &Row<'_>) -> Result<(f64, f64), String> {
-    let (start, end) = (row.f64("start")?, row.f64("end")?);
+    let (start, end) = (row.time("start")?, row.time("end")?);
     if end < start {
         return Err(format!(
             "end {end} is before start {start}; an interval must have end >= start"
@@ -293,10 +325,10 @@ fn read_encounters(path: &Path) -> Result<Vec<Encounter>, LogError> {
         }
         let truth = if with_truth {
             Some([
-                row.f64("a_x")?,
-                row.f64("a_y")?,
-                row.f64("b_x")?,
-                row.f64("b_y")?,
+                row.position("a_x")?,
+                row.position("a_y")?,
+                row.position("b_x")?,
+                row.position("b_y")?,
             ])
         } else {
             None
@@ -356,7 +388,7 @@ fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
     let mut f = CsvFile::open(path, &["time", "x"])?;
     let mut out = Vec::new();
     f.for_each(|row| {
-        out.push((row.f64("time")?, row.f64("x")?));
+        out.push((row.time("time")?, row.position("x")?));
         Ok(())
     })?;
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -427,6 +459,16 @@ mod tests {
         let e = error_of("start,end,a,b\nNaN,1,0,1\n");
         assert!(
             e.contains(":2: column `start` is `NaN`; times and positions must be finite"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b\n0,1e200,0,1\n");
+        assert!(
+            e.contains(":2: column `end` is `1e200`, beyond ±1e12 s") && e.contains("divide by"),
+            "{e}"
+        );
+        let e = error_of("start,end,a,b,a_x,a_y,b_x,b_y\n0,1,0,1,0,0,-2e9,0\n");
+        assert!(
+            e.contains(":2: column `b_x` is `-2e9`, beyond ±1e9 m"),
             "{e}"
         );
         let e = error_of("start,end,a\n0,1,0\n");

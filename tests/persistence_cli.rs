@@ -104,6 +104,13 @@ fn bad_files_name_the_line_and_exit_2() {
         &[],
         ":2: coordinate 1 of point 1 is not a finite number",
     );
+    // Regression: coordinates this large made every distance overflow to infinity, and
+    // the diagram came out with every point an essential class, without a word.
+    bad(
+        "0,0\n1,0\n3e200,1\n",
+        &[],
+        ":3: coordinate 0 of point 2 is 3e200, beyond ±1e150: squared distances would overflow",
+    );
     bad("", &[], "no rows");
     bad(
         "0,1\n2,0\n",

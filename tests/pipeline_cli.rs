@@ -2,6 +2,7 @@
 //! determinism of the mapping outputs.
 
 use assert_cmd::Command;
+use predicates::prelude::PredicateBooleanExt;
 use predicates::str::contains;
 use std::fs;
 use std::path::Path;
@@ -184,6 +185,43 @@ fn a_malformed_log_names_the_line_and_exits_2() {
         .assert()
         .code(2)
         .stderr(contains("encounters.csv:2: end 2 is before start 5"));
+}
+
+/// Regression: a log with finite but absurd times (1e200 s) panicked in the `Embedded`
+/// mapping: the landmarks' encounters are close to each other, but landmark MDS squares the
+/// rows to every other encounter, which overflowed, and the embedding came back with no
+/// points. Such times are now rejected where they are read, with the line and a hint, and
+/// exit 2 (this log panicked the previous build).
+#[test]
+fn a_log_with_absurd_times_is_rejected_not_mapped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let rows: String = (0..400)
+        .map(|i| {
+            let (a, b) = (i % 20, (i * 7 + 3) % 20);
+            let b = if a == b { (b + 1) % 20 } else { b };
+            let t = i as f64 * 5e197;
+            format!("{t:e},{:e},{},{}\n", t + 1e195, a.min(b), a.max(b))
+        })
+        .collect();
+    fs::write(
+        tmp.path().join("encounters.csv"),
+        format!("start,end,a,b\n{rows}"),
+    )
+    .unwrap();
+    fs::write(
+        tmp.path().join("static_intervals.csv"),
+        "agent,start,end,reason\n0,0,2e200,landmark\n1,0,2e200,landmark\n2,0,2e200,landmark\n",
+    )
+    .unwrap();
+    swarmmap()
+        .args(["map", "--method", "embedded"])
+        .arg(tmp.path())
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "encounters.csv:2: column `end` is `1e195`, beyond ±1e12 s",
+        ))
+        .stderr(contains("panicked").not());
 }
 
 #[test]

@@ -281,9 +281,32 @@ fn agents_must_not_be_zero() {
         &error_with("swarm.agents", "0"),
         &[
             "swarm.agents is 0 (must be at least 1)",
-            "use at least one agent",
+            "use 1 to 1 000 000 agents",
         ],
     );
+    assert_has(
+        &error_with("swarm.agents", "2000000"),
+        &[
+            "swarm.agents is 2000000 (must be at most 1000000)",
+            "use 1 to 1 000 000 agents",
+        ],
+    );
+    assert_has(
+        &error_with("mapping.windows", "20000"),
+        &[
+            "mapping.windows is 20000 (must be at most 10000)",
+            "use 1 to 10 000 windows",
+        ],
+    );
+}
+
+/// A sweep too long for the step limit says its duration in a readable form, not as a
+/// 200-digit number.
+#[test]
+fn an_overlong_run_names_its_duration_compactly() {
+    let e = error_of("(arena: (width: 1e200, height: 10.0))");
+    assert_has(&e, &["the 2.000e202 s run needs 6.667e203 steps"]);
+    assert!(!e.contains("00000000000"), "{e}");
 }
 
 #[test]

@@ -120,6 +120,7 @@ fn matrix(rows: &[Row]) -> Result<DistanceMatrix, MatrixError> {
 fn located(file: &Path, rows: &[Row], e: MatrixError) -> anyhow::Error {
     let row = match e {
         MatrixError::NonFinite { row, .. }
+        | MatrixError::TooLarge { row, .. }
         | MatrixError::NotSquare { row, .. }
         | MatrixError::Diagonal { row, .. }
         | MatrixError::BadEntry { row, .. }

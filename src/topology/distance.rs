@@ -33,6 +33,13 @@ impl PointCloud {
                 col: k % dim,
             });
         }
+        if let Some(k) = coords.iter().position(|c| c.abs() > MAX_COORDINATE) {
+            return Err(MatrixError::TooLarge {
+                row: k / dim,
+                col: k % dim,
+                value: coords[k],
+            });
+        }
         Ok(Self { dim, coords })
     }
 
@@ -237,6 +244,11 @@ impl DistanceMatrix {
     }
 }
 
+/// Largest |coordinate| of a [`PointCloud`]: the squared difference of two coordinates stays
+/// below 4e300, so Euclidean distances in up to ~40 dimensions cannot overflow f64 (beyond
+/// that they would silently become infinite and every class essential).
+pub const MAX_COORDINATE: f64 = 1e150;
+
 /// What is wrong with a point cloud or distance matrix.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MatrixError {
@@ -248,6 +260,10 @@ pub enum MatrixError {
     Ragged { len: usize, dim: usize },
     #[error("coordinate {col} of point {row} is not a finite number")]
     NonFinite { row: usize, col: usize },
+    #[error(
+        "coordinate {col} of point {row} is {value:e}, beyond ±1e150: squared distances would overflow; rescale the points"
+    )]
+    TooLarge { row: usize, col: usize, value: f64 },
     #[error("a condensed matrix for this many points needs {want} entries, got {len}")]
     CondensedLength { len: usize, want: usize },
     #[error(

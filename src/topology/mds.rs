@@ -167,7 +167,7 @@ pub fn classical_mds_with(
             }
         }
     }
-    Ok(spec.into_embedding(k, coords))
+    spec.into_embedding(k, coords)
 }
 
 /// Landmark MDS (de Silva & Tenenbaum 2004).
@@ -268,7 +268,7 @@ pub fn landmark_mds_with(
             out[c] = -0.5 * s;
         }
     });
-    Ok(spec.into_embedding(k, coords))
+    spec.into_embedding(k, coords)
 }
 
 /// The top of the spectrum of `B` and the masses of the whole spectrum.
@@ -291,7 +291,10 @@ impl Spectrum {
         ZERO_REL * self.radius
     }
 
-    fn into_embedding(self, k: usize, coords: Vec<f64>) -> Embedding {
+    /// The embedding, or [`MdsError::Overflow`] when a coordinate is not finite: the
+    /// landmarks' own distances can be small while the rows to other points are finite but
+    /// so large that their squares overflow (landmark MDS squares every row entry).
+    fn into_embedding(self, k: usize, coords: Vec<f64>) -> Result<Embedding, MdsError> {
         let noise = self.noise();
         let mut eigenvalues = self.values;
         eigenvalues.resize(k, 0.0);
@@ -308,27 +311,18 @@ impl Spectrum {
         } else {
             0.0
         };
-        let coords = match PointCloud::new(k, coords) {
-            Ok(c) => c,
-            // Non-finite coordinates can only come from non-finite distances, which
-            // DistanceMatrix::from_condensed rejects; keep the dimension, drop the points.
-            Err(_) => PointCloud::new(k, Vec::new()).unwrap_or_else(|_| unreachable_cloud()),
-        };
-        Embedding {
+        // k ≥ 1 is checked before any embedding is built, so the only way PointCloud::new
+        // can fail is a non-finite coordinate.
+        let coords = PointCloud::new(k, coords).map_err(|_| MdsError::Overflow)?;
+        Ok(Embedding {
             coords,
             eigenvalues,
             explained,
             clipped,
             negative_mass,
             spectrum_exact: self.exact,
-        }
+        })
     }
-}
-
-#[cold]
-fn unreachable_cloud() -> PointCloud {
-    // k ≥ 1 is checked before any embedding is built, so PointCloud::new(k, []) cannot fail.
-    PointCloud::from_rows::<Vec<f64>>(&[]).unwrap_or_else(|_| unreachable!("k ≥ 1 is checked"))
 }
 
 /// Top-k eigenpairs of `B = −½ J D² J` (block Krylov + Rayleigh–Ritz) and the spectral masses.
@@ -799,6 +793,19 @@ mod tests {
         ));
         let huge = DistanceMatrix::from_fn(3, |_, _| 1e200);
         assert_eq!(classical_mds(&huge, 2), Err(MdsError::Overflow));
+        // Landmarks close together, a point finite but so far that its squared distances
+        // overflow: an error, not an embedding without points (which callers indexed).
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|a| {
+                let mut r: Vec<f64> = (0..3).map(|b| if a == b { 0.0 } else { 1.0 }).collect();
+                r.push(1e200);
+                r
+            })
+            .collect();
+        assert!(matches!(
+            landmark_mds(&[0, 1, 2], &rows, 2),
+            Err(MdsError::Overflow)
+        ));
         let two = DistanceMatrix::from_condensed(2, vec![2.0]).unwrap();
         let e = classical_mds(&two, 3).unwrap();
         assert!(

@@ -365,7 +365,7 @@ impl WorldSpec {
             s.agents.unwrap_or(d.agents as i64),
             1,
             MAX_AGENTS,
-            "use at least one agent (the paper uses 100)",
+            "use 1 to 1 000 000 agents (the paper uses 100)",
         )?;
         let speed = ctx.positive(
             "swarm.speed",
@@ -570,7 +570,7 @@ impl WorldSpec {
             m.windows.unwrap_or(md.windows as i64),
             1,
             MAX_WINDOWS,
-            "use at least one window (the paper uses 4 to 6)",
+            "use 1 to 10 000 windows (the paper uses 4 to 6)",
         )?;
         let overlap = ctx.non_negative(
             "mapping.overlap",
@@ -634,7 +634,15 @@ impl WorldSpec {
         if total / dt > MAX_STEPS {
             return Err(ctx.err(
                 "simulation.dt",
-                format!("is {dt} s, so the {total} s run needs {:.3e} steps (at most {MAX_STEPS:e} allowed)", total / dt),
+                format!(
+                    "is {dt} s, so the {} s run needs {:.3e} steps (at most {MAX_STEPS:e} allowed)",
+                    if total < 1e9 {
+                        short(total)
+                    } else {
+                        format!("{total:.3e}")
+                    },
+                    total / dt
+                ),
                 "use a larger time step, a faster leader or a shorter sweep",
             ));
         }
