@@ -76,6 +76,26 @@ fn a_bad_model_file_is_an_input_error_naming_it() {
         .stderr(contains("is not a model file"));
 }
 
+/// Regression: a cap outside [0, 1] was accepted and fitted as if unconstrained.
+#[test]
+fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    for cap in ["2", "-0.1", "NaN"] {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .args(["calibrate", WORLD, "--seeds", "1"])
+            .arg(format!("--max-false-holes={cap}"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(2)
+            .stderr(contains(format!("--max-false-holes is {cap}")))
+            .stderr(contains("from 0 to 1"));
+    }
+    assert!(!out.exists(), "nothing is fitted or written");
+}
+
 #[test]
 fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
     let dir = tempfile::tempdir().unwrap();

@@ -158,6 +158,28 @@ fn the_embedded_method_maps_a_log_with_or_without_landmarks() {
     assert_eq!(s["global"]["betti"][0], 2, "{s}");
 }
 
+/// `map --windows` takes the range a world file's `mapping.windows` takes: 0 windows map
+/// nothing, and 100 000 windows of a short log ran for minutes writing one file each.
+#[test]
+fn map_rejects_a_window_count_outside_1_to_10000() {
+    let tmp = tempfile::tempdir().unwrap();
+    fs::write(
+        tmp.path().join("encounters.csv"),
+        "start,end,a,b\n1.0,2.0,0,1\n",
+    )
+    .unwrap();
+    for n in ["0", "10001"] {
+        swarmmap()
+            .args(["map", "--windows", n])
+            .arg(tmp.path())
+            .assert()
+            .code(2)
+            .stderr(contains(format!(
+                "--windows is {n}; use 1 to 10000 windows"
+            )));
+    }
+}
+
 #[test]
 fn a_malformed_log_names_the_line_and_exits_2() {
     let tmp = tempfile::tempdir().unwrap();

@@ -77,6 +77,12 @@ impl CvGroups {
 
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     let seeds = super::eval::parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
+    if !(0.0..=1.0).contains(&args.max_false_holes) {
+        return Err(input(anyhow!(
+            "--max-false-holes is {}; it is a share of the hole-free training windows, from 0 to 1 (1 = unconstrained)",
+            args.max_false_holes
+        )));
+    }
     let mut paths = args.worlds.clone();
     if paths.is_empty() {
         let dir = PathBuf::from("worlds/training");

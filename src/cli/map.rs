@@ -90,8 +90,11 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
     };
     if let Some(n) = args.windows {
-        if n == 0 {
-            return Err(input(anyhow::anyhow!("--windows must be at least 1")));
+        if n == 0 || n > swarmmap::world::MAX_WINDOWS {
+            return Err(input(anyhow::anyhow!(
+                "--windows is {n}; use 1 to {} windows, as in a world file's mapping.windows (the paper uses 4 to 6)",
+                swarmmap::world::MAX_WINDOWS
+            )));
         }
         cfg.windows = n;
     }
