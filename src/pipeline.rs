@@ -77,6 +77,25 @@ impl Timings {
     }
 }
 
+/// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the
+/// world's own `seed` field, which `--seed` overrides), if there is one.
+pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
+    let path = dir.join("meta.json");
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).map_err(|e| PipelineError::Meta {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| PipelineError::Meta {
+            path: path.clone(),
+            message: format!("not valid JSON: {e}"),
+        })?;
+    Ok(value.get("seed").and_then(serde_json::Value::as_u64))
+}
+
 /// Reads the world a simulation ran with from its `meta.json`, if there is one.
 pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
     let path = dir.join("meta.json");

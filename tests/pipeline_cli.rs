@@ -63,6 +63,40 @@ fn run_writes_every_output_and_is_deterministic() {
     assert_eq!(summary_without_timings(&a), summary_without_timings(&b));
 }
 
+/// Regression: `map` on a run made with `--seed 3` wrote `"seed": 1` into summary.json (the
+/// world file's own `seed` field, from meta.json's copy of the world) instead of the run's.
+#[test]
+fn map_reports_the_seed_the_run_was_made_with() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    swarmmap()
+        .args([
+            "run",
+            TINY,
+            "--seed",
+            "3",
+            "--no-report",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .assert()
+        .success();
+    assert_eq!(json(&dir.join("summary.json"))["seed"], 3);
+    swarmmap().arg("map").arg(&dir).assert().success();
+    assert_eq!(json(&dir.join("summary.json"))["seed"], 3, "after map");
+    // A real log has no seed, whatever world file it is judged against.
+    let bare = tmp.path().join("bare");
+    fs::create_dir(&bare).unwrap();
+    fs::copy(dir.join("encounters.csv"), bare.join("encounters.csv")).unwrap();
+    swarmmap()
+        .args(["map", "--world", TINY])
+        .arg(&bare)
+        .assert()
+        .success();
+    assert!(json(&bare.join("summary.json"))["seed"].is_null());
+}
+
 /// A simulated log stripped to what a real experiment would record: `encounters.csv`
 /// without truth columns and `static_intervals.csv`, no metadata.
 fn real_log(tmp: &Path) -> std::path::PathBuf {

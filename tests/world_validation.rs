@@ -261,6 +261,8 @@ fn meaningless_numbers_are_rejected_everywhere() {
         ("mapping.cluster_cutoff", "0.0", "must be > 0"),
         ("mapping.subsample", "0", "must be at least 1"),
         ("mapping.neighbours", "-1", "must be at least 0"),
+        ("mapping.switch_cost", "-1.0", "must be ≥ 0 seconds"),
+        ("mapping.switch_cost", "inf", "must be a finite number"),
         ("swarm.agents", "-5", "must be at least 1"),
     ];
     for (path, value, rule) in cases {

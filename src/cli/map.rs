@@ -10,7 +10,7 @@ use swarmmap::log::StaticReason;
 use swarmmap::mapping::local::LocalParams;
 use swarmmap::mapping::pipeline::MapConfig;
 use swarmmap::mapping::stitch::StitchParams;
-use swarmmap::pipeline::{Timings, map_log, world_from_run, write_maps};
+use swarmmap::pipeline::{Timings, map_log, seed_from_run, world_from_run, write_maps};
 use swarmmap::world::{MappingMethod, MappingParams};
 
 /// Options of `swarmmap map`.
@@ -127,7 +127,9 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         );
     }
     let mut timings = Timings::default();
-    let seed = world.as_ref().map(|w| w.seed);
+    // The run's seed (a real log has none): a world file's `seed` field says nothing about
+    // which seed produced this log.
+    let seed = seed_from_run(&args.run_dir).map_err(input)?;
     let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(input)?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());

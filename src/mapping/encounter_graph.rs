@@ -39,6 +39,25 @@
 //! after a pause is close to the encounters during it (the agent had not moved). This is a
 //! tighter upper bound on travel time than the paper's rule; it is one of the improvements
 //! measured by `swarmmap eval`.
+//!
+//! # Agent switches
+//!
+//! A path of the paper's graph walks along one agent's time line and, at an encounter,
+//! may switch to the other agent's line for free. Each switch moves the path's position by
+//! up to r_d (the two agents were within r_d, not at one point), so a chain of quick
+//! contacts crosses space at no cost in time: in a dense swarm shortest paths pick chains
+//! whose offsets happen to line up, and the metric falls far below travel time (README,
+//! "Accuracy", step 13: at 200 agents, median metric × v ÷ true distance 0.41–0.58
+//! between landmark sites). With a switch cost σ_s
+//! ([`EncounterGraph::build_switching`]) each encounter becomes two halves, one on each
+//! agent's line, joined by an edge of weight σ_s; the lines and static stars are built on
+//! the halves exactly as above (the claim is per agent line, so the sparse forest still
+//! has the clique's shortest paths; `sparse_equals_clique_with_switches` checks it), and an
+//! encounter's distance to another is the smaller over their halves. Encounters sharing an
+//! agent keep the paper's weight; every change of agent costs σ_s. With σ_s = r_d / v,
+//! v × metric bounds the distance between the agents' positions from above: every second
+//! of a line is at most v of travel and every switch at most r_d. σ_s = 0 is the paper's
+//! graph, built without halves.
 
 use crate::log::{AgentId, Encounter, StaticInterval};
 use std::collections::HashMap;
@@ -53,10 +72,14 @@ pub enum Bridging {
 }
 
 /// A weighted undirected graph in compressed sparse row form. Vertices `0..encounters`
-/// are encounters (in the order given); the rest are virtual static-interval vertices.
+/// are encounters (in the order given); with a switch cost, `encounters..2 · encounters`
+/// are their second halves (agent `b`'s side; vertex `i` is then agent `a`'s side); the
+/// rest are virtual static-interval vertices.
 #[derive(Debug, Clone)]
 pub struct EncounterGraph {
     encounters: usize,
+    /// Whether every encounter is split into two halves joined by the switch cost.
+    halves: bool,
     offsets: Vec<usize>,
     targets: Vec<u32>,
     weights: Vec<f64>,
@@ -76,20 +99,38 @@ impl EncounterGraph {
     /// Builds the sparse graph of `encounters` with the static intervals `statics`
     /// (those that meet no encounter are ignored).
     pub fn build(encounters: &[Encounter], statics: &[StaticInterval], bridging: Bridging) -> Self {
+        Self::build_switching(encounters, statics, bridging, 0.0)
+    }
+
+    /// [`EncounterGraph::build`] with a cost of `switch` seconds for every change of agent
+    /// along a path (module docs, "Agent switches"); `0` gives the paper's graph exactly.
+    /// A negative or non-finite `switch` is treated as `0`.
+    pub fn build_switching(
+        encounters: &[Encounter],
+        statics: &[StaticInterval],
+        bridging: Bridging,
+        switch: f64,
+    ) -> Self {
         let n = encounters.len();
+        let halves = switch.is_finite() && switch > 0.0;
         let mut lines: HashMap<AgentId, Vec<Item>> = HashMap::new();
         for (i, e) in encounters.iter().enumerate() {
-            for agent in [e.a, e.b] {
+            for (side, agent) in [e.a, e.b].into_iter().enumerate() {
+                let vertex = if halves && side == 1 { n + i } else { i };
                 lines.entry(agent).or_default().push(Item {
                     start: e.start,
                     end: e.end,
-                    vertex: i as u32,
+                    vertex: vertex as u32,
                     on_line: true,
                 });
             }
         }
-        let mut edges: Vec<(u32, u32, f64)> = Vec::with_capacity(2 * n);
-        let mut next_vertex = n as u32;
+        let mut edges: Vec<(u32, u32, f64)> = Vec::with_capacity(3 * n);
+        let encounter_vertices = if halves { 2 * n } else { n };
+        if halves {
+            edges.extend((0..n).map(|i| (i as u32, (n + i) as u32, switch)));
+        }
+        let mut next_vertex = encounter_vertices as u32;
         // Static intervals sorted by agent then start, so vertex numbering is deterministic.
         let mut statics: Vec<&StaticInterval> = statics.iter().collect();
         statics.sort_by(|x, y| x.agent.cmp(&y.agent).then(x.start.total_cmp(&y.start)));
@@ -99,7 +140,7 @@ impl EncounterGraph {
             };
             let members: Vec<u32> = line
                 .iter()
-                .filter(|it| it.on_line && it.vertex < n as u32)
+                .filter(|it| it.on_line && (it.vertex as usize) < encounter_vertices)
                 .filter(|it| it.start <= s.end && s.start <= it.end)
                 .map(|it| it.vertex)
                 .collect();
@@ -134,10 +175,15 @@ impl EncounterGraph {
                 }
             }
         }
-        Self::from_edges(n, next_vertex as usize, &edges)
+        Self::from_edges(n, halves, next_vertex as usize, &edges)
     }
 
-    fn from_edges(encounters: usize, vertices: usize, edges: &[(u32, u32, f64)]) -> Self {
+    fn from_edges(
+        encounters: usize,
+        halves: bool,
+        vertices: usize,
+        edges: &[(u32, u32, f64)],
+    ) -> Self {
         let mut degree = vec![0usize; vertices + 1];
         for &(a, b, _) in edges {
             degree[a as usize + 1] += 1;
@@ -160,6 +206,7 @@ impl EncounterGraph {
         }
         Self {
             encounters,
+            halves,
             offsets,
             targets,
             weights,
@@ -171,7 +218,7 @@ impl EncounterGraph {
         self.encounters
     }
 
-    /// Number of vertices, virtual static vertices included.
+    /// Number of vertices, encounter halves and virtual static vertices included.
     pub fn vertices(&self) -> usize {
         self.offsets.len() - 1
     }
@@ -190,9 +237,14 @@ impl EncounterGraph {
     pub fn distances_from(&self, source: usize) -> Vec<f64> {
         let mut dist = vec![f64::INFINITY; self.vertices()];
         let mut heap = RadixHeap::new();
-        dist[source] = 0.0;
-        // Non-negative f64 bit patterns order like the numbers, so u64 keys are exact.
-        heap.push(0f64.to_bits(), source as u32);
+        let n = self.encounters;
+        // An encounter is both of its halves: either agent's side can start a path.
+        let sources = [Some(source), self.halves.then_some(n + source)];
+        for v in sources.into_iter().flatten() {
+            dist[v] = 0.0;
+            // Non-negative f64 bit patterns order like the numbers, so u64 keys are exact.
+            heap.push(0f64.to_bits(), v as u32);
+        }
         while let Some((bits, u)) = heap.pop() {
             let d = f64::from_bits(bits);
             let u = u as usize;
@@ -208,7 +260,13 @@ impl EncounterGraph {
                 }
             }
         }
-        dist.truncate(self.encounters);
+        if self.halves {
+            let (a, b) = dist.split_at_mut(n);
+            for (x, &y) in a.iter_mut().zip(&b[..n]) {
+                *x = x.min(y);
+            }
+        }
+        dist.truncate(n);
         dist
     }
 
@@ -450,6 +508,119 @@ mod tests {
             }
             assert!(g.edges() <= 2 * enc.len() + enc.len() * 2);
         }
+    }
+
+    /// The split graph built literally: both halves of every encounter, a clique per agent
+    /// on its halves with the paper's weights, the switch edge inside each encounter; then
+    /// Floyd–Warshall, and an encounter's distance the smaller over its halves.
+    fn clique_metric_with_switches(
+        enc: &[Encounter],
+        statics: &[StaticInterval],
+        switch: f64,
+    ) -> Vec<Vec<f64>> {
+        let n = enc.len();
+        let half = |i: usize, agent: u32| if enc[i].a == agent { i } else { n + i };
+        let mut d = vec![vec![f64::INFINITY; 2 * n]; 2 * n];
+        for i in 0..n {
+            d[i][i] = 0.0;
+            d[n + i][n + i] = 0.0;
+            d[i][n + i] = switch;
+            d[n + i][i] = switch;
+            for j in 0..n {
+                if i == j {
+                    continue;
+                }
+                let (x, y) = (&enc[i], &enc[j]);
+                for s in [x.a, x.b] {
+                    if s != y.a && s != y.b {
+                        continue;
+                    }
+                    let bridged = statics.iter().any(|st| {
+                        st.agent == s
+                            && meets((x.start, x.end), (st.start, st.end))
+                            && meets((y.start, y.end), (st.start, st.end))
+                    });
+                    let w = if bridged { 0.0 } else { gap(x, y) };
+                    let (u, v) = (half(i, s), half(j, s));
+                    d[u][v] = d[u][v].min(w);
+                }
+            }
+        }
+        for k in 0..2 * n {
+            for i in 0..2 * n {
+                for j in 0..2 * n {
+                    let via = d[i][k] + d[k][j];
+                    if via < d[i][j] {
+                        d[i][j] = via;
+                    }
+                }
+            }
+        }
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        [d[i][j], d[i][n + j], d[n + i][j], d[n + i][n + j]]
+                            .into_iter()
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn sparse_equals_clique_with_switches() {
+        for seed in 0..30 {
+            let (enc, statics) = random_log(seed, 30, 6);
+            for switch in [0.5, 3.0] {
+                let g = EncounterGraph::build_switching(&enc, &statics, Bridging::Paper, switch);
+                let want = clique_metric_with_switches(&enc, &statics, switch);
+                for (i, row) in want.iter().enumerate() {
+                    let got = g.distances_from(i);
+                    for (j, w) in row.iter().enumerate() {
+                        assert!(
+                            (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
+                            "seed {seed}, switch {switch}: d({i},{j}) sparse {} clique {}",
+                            got[j],
+                            w
+                        );
+                    }
+                }
+            }
+            // A zero switch cost is the paper's graph itself.
+            let paper = EncounterGraph::build(&enc, &statics, Bridging::Paper);
+            let zero = EncounterGraph::build_switching(&enc, &statics, Bridging::Paper, 0.0);
+            assert_eq!(paper.vertices(), zero.vertices());
+            for i in 0..enc.len() {
+                assert_eq!(paper.distances_from(i), zero.distances_from(i));
+            }
+        }
+    }
+
+    /// A chain of quick contacts: agent 0 meets 1 at t = 0, 1 meets 2 at t = 0.1, 2 meets 3
+    /// at t = 0.2. Free switches make the ends 0.2 s apart; the path changes agent once (1 →
+    /// 2 at the middle encounter), so with σ_s = 1 s they are 1.2 s apart, while two
+    /// encounters on one agent's line keep the paper's weight.
+    #[test]
+    fn every_change_of_agent_costs_the_switch() {
+        let e = |a, b, t| Encounter {
+            start: t,
+            end: t,
+            a,
+            b,
+            truth: None,
+        };
+        let enc = vec![e(0, 1, 0.0), e(1, 2, 0.1), e(2, 3, 0.2), e(0, 4, 5.0)];
+        let free = EncounterGraph::build(&enc, &[], Bridging::Paper);
+        assert!((free.distances_from(0)[2] - 0.2).abs() < 1e-12);
+        let g = EncounterGraph::build_switching(&enc, &[], Bridging::Paper, 1.0);
+        let d = g.distances_from(0);
+        assert!((d[1] - 0.1).abs() < 1e-12, "shared agent 1: no switch");
+        assert!((d[2] - 1.2).abs() < 1e-12, "one switch (1 → 2): {}", d[2]);
+        assert!((d[3] - 5.0).abs() < 1e-12, "shared agent 0: no switch");
+        assert_eq!(g.distances_from(2)[0], d[2], "symmetric");
+        assert_eq!(free.components(), g.components());
     }
 
     #[test]

@@ -33,6 +33,9 @@ use serde::Serialize;
 pub struct LocalParams {
     /// How static intervals bridge time (default: the paper's rule).
     pub bridging: Bridging,
+    /// Cost in seconds of a change of agent along a path (default: `0.0`, the paper's
+    /// metric; [`super::encounter_graph`], "Agent switches").
+    pub switch_cost: f64,
     /// Subsampling (default: m = 400).
     pub subsample: SubsampleParams,
     /// Smallest number of encounters of a real component (default: `20`).
@@ -61,6 +64,7 @@ impl Default for LocalParams {
     fn default() -> Self {
         Self {
             bridging: Bridging::Paper,
+            switch_cost: 0.0,
             subsample: SubsampleParams::default(),
             min_component: 20,
             min_share: 0.02,
@@ -80,6 +84,7 @@ impl LocalParams {
         p.subsample.m = m.subsample;
         p.classifier = super::classify::Models::shipped().get(m.method).classifier;
         p.bridging = Bridging::Paper;
+        p.switch_cost = m.switch_cost;
         if m.method == crate::world::MappingMethod::Embedded {
             p.anchored = true;
             p.embedding_rips = Some(super::dense::DenseParams::embedded());
@@ -192,7 +197,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         })
         .cloned()
         .collect();
-    let graph = EncounterGraph::build(&enc, &statics, p.bridging);
+    let graph = EncounterGraph::build_switching(&enc, &statics, p.bridging, p.switch_cost);
     // Whether an encounter involves an agent that was a landmark at the time: its position
     // is the landmark's. Landmark intervals are indexed by agent, so this is O(E · k) for
     // k intervals per agent, not O(E · all intervals).

@@ -133,6 +133,7 @@ pub fn world_json(world: &World) -> Value {
             "subsample": m.subsample,
             "neighbours": m.neighbours,
             "method": format!("{:?}", m.method),
+            "switch_cost": m.switch_cost,
         },
         "seed": world.seed,
     })

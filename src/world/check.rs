@@ -598,6 +598,12 @@ impl WorldSpec {
             usize::MAX,
             "use a non-negative number of neighbours, e.g. 5",
         )?;
+        let switch_cost = ctx.non_negative(
+            "mapping.switch_cost",
+            m.switch_cost.unwrap_or(md.switch_cost),
+            "seconds",
+            "use 0 (the paper's metric) or a positive cost per change of agent, e.g. detection_radius / speed",
+        )?;
         let method = match m.method {
             None | Some(MethodSpec::Paper) => MappingMethod::Paper,
             Some(MethodSpec::Embedded) => MappingMethod::Embedded,
@@ -609,6 +615,7 @@ impl WorldSpec {
             subsample,
             neighbours,
             method,
+            switch_cost,
         };
 
         let world = World {

@@ -108,6 +108,7 @@ pub struct MappingSpec {
     pub subsample: Option<i64>,
     pub neighbours: Option<i64>,
     pub method: Option<MethodSpec>,
+    pub switch_cost: Option<f64>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -263,6 +264,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.subsample",
     "mapping.neighbours",
     "mapping.method",
+    "mapping.switch_cost",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -379,6 +381,7 @@ impl WorldSpec {
                             "subsample" => put(&mut s.subsample, p, v)?,
                             "neighbours" => put(&mut s.neighbours, p, v)?,
                             "method" => put(&mut s.method, p, v)?,
+                            "switch_cost" => put(&mut s.switch_cost, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

@@ -151,6 +151,9 @@ pub struct MappingParams {
     pub neighbours: usize,
     /// Local-mapping method (default: `Paper`).
     pub method: MappingMethod,
+    /// Cost in seconds of every change of agent along a path of the encounter graph
+    /// (`mapping::encounter_graph`, "Agent switches"; default: `0.0`, the paper's metric).
+    pub switch_cost: f64,
 }
 
 impl Default for MappingParams {
@@ -162,6 +165,7 @@ impl Default for MappingParams {
             subsample: 400,
             neighbours: 5,
             method: MappingMethod::Paper,
+            switch_cost: 0.0,
         }
     }
 }
