@@ -16,6 +16,7 @@ use crate::mapping::pipeline::{MapConfig, map_windows, summarise};
 use crate::mapping::stitch::{Connection, GlobalMap, StitchParams, connect, global_map};
 use crate::sim::{SimError, SimOptions, SimOutput, simulate, write_run};
 use crate::world::{World, WorldError, WorldSpec};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -131,10 +132,12 @@ pub fn map_log(
 ) -> Result<Mapped, PipelineError> {
     let maps = timings.time("local maps", || map_windows(log, cfg));
     let windows = cfg.windows();
+    // Consecutive pairs are independent: stitch them in parallel (collected in order, so
+    // the result does not depend on the number of threads).
     let connections: Vec<Connection> = timings.time("stitching", || {
-        windows
-            .windows(2)
-            .zip(maps.windows(2))
+        let pairs: Vec<_> = windows.windows(2).zip(maps.windows(2)).collect();
+        pairs
+            .par_iter()
             .map(|(w, m)| connect(log, &w[0], &w[1], &m[0], &m[1], &cfg.local, stitch))
             .collect()
     });

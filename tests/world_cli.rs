@@ -20,7 +20,7 @@ fn check_prints_a_summary_of_each_scenario() {
             .success()
             .stdout(predicate::str::contains(format!("obstacles  {obstacles}")))
             .stdout(predicate::str::contains("30 m × 10 m"))
-            .stdout(predicate::str::contains("100 agents, 30 landmarks"))
+            .stdout(predicate::str::contains("200 agents, 60 landmarks"))
             .stdout(predicate::str::contains("r_d = 0.1 m"))
             .stdout(predicate::str::contains("sweeps x 1.5 → 28.5 m"))
             .stdout(predicate::str::contains("sweep 5400 s = 5700 s"))

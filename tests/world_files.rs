@@ -99,22 +99,45 @@ fn every_bundled_world_is_valid() {
     assert!(std::path::Path::new("worlds/training").is_dir());
 }
 
-/// The paper's parameters, except the sensing and method that the accuracy campaign chose
-/// (README, "Accuracy"): r_d = 10 cm, 30 % landmarks, the `Embedded` method.
+/// The paper's parameters, except the sensing, swarm size and method that the accuracy
+/// campaign chose (README, "Accuracy", steps 2 and 13): r_d = 10 cm, 30 % landmarks, 200
+/// agents, the `Embedded` method with a switch cost of r_d / v = 1 s, c = 35.
 #[test]
 fn the_scenarios_use_the_papers_parameters_but_the_measured_sensing() {
     for (name, windows) in [("scenario1", 4), ("scenario2", 6), ("scenario3", 5)] {
         let w = load(name);
         assert_eq!(w.mapping.windows, windows, "{name}");
-        assert_eq!(w.swarm.agents, 100);
+        assert_eq!(w.swarm.agents, 200);
+        assert_eq!(
+            w.mapping.switch_cost,
+            w.swarm.detection_radius / w.swarm.speed
+        );
         assert_eq!(w.swarm.landmark_fraction, 0.3);
         assert_eq!(w.swarm.detection_radius, 0.1);
         assert_eq!(w.mapping.method, swarmmap::world::MappingMethod::Embedded);
         assert_eq!(w.swarm.speed, 0.1);
         assert_eq!(w.leader.speed, 0.005);
         assert_eq!(w.leader.window, 3.0);
-        assert_eq!(w.mapping.cluster_cutoff, 50.0);
+        assert_eq!(w.mapping.cluster_cutoff, 35.0);
     }
+}
+
+/// The training worlds are mapped as the bundled worlds are, so that a model fitted on
+/// them (`swarmmap calibrate`) is the model the bundled worlds need.
+#[test]
+fn training_worlds_sense_and_map_like_the_bundled_ones() {
+    let s1 = load("scenario1");
+    let mut n = 0;
+    for entry in std::fs::read_dir("worlds/training").unwrap() {
+        let path = entry.unwrap().path();
+        let w = World::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(w.swarm, s1.swarm, "{}", path.display());
+        assert_eq!(w.mapping.method, s1.mapping.method);
+        assert_eq!(w.mapping.switch_cost, s1.mapping.switch_cost);
+        assert_eq!(w.mapping.cluster_cutoff, s1.mapping.cluster_cutoff);
+        n += 1;
+    }
+    assert_eq!(n, 10);
 }
 
 #[test]

@@ -148,7 +148,9 @@ pub fn summarise(
     log: &EncounterLog,
     truth: Option<(&World, &FreeSpace)>,
 ) -> Vec<WindowSummary> {
-    maps.iter()
+    // Windows are independent (the fidelity reruns the topology stage on true positions):
+    // in parallel, collected in order.
+    maps.par_iter()
         .map(|m| {
             let band = truth.map(|(w, _)| window_band(w, m.start, m.end));
             let diagonal = match (truth, band) {

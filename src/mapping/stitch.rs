@@ -47,6 +47,7 @@ use super::windows::Window;
 use crate::log::{AgentId, EncounterLog, StaticReason};
 use crate::topology::DistanceMatrix;
 use crate::topology::linkage::single_linkage;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
@@ -151,8 +152,14 @@ pub fn connect(
     // other encounters.
     let mut cloud: Vec<usize> = Vec::new();
     let mut seen = BTreeSet::new();
-    for ks in anchors.values() {
-        let row = graph.distances_from(ks[0]);
+    // One shortest-path run per anchor and per cloud point, each independent: in parallel,
+    // collected in order.
+    let anchor_list: Vec<&Vec<usize>> = anchors.values().collect();
+    let anchor_rows: Vec<Vec<f64>> = anchor_list
+        .par_iter()
+        .map(|ks| graph.distances_from(ks[0]))
+        .collect();
+    for (ks, row) in anchor_list.iter().zip(&anchor_rows) {
         if seen.insert(ks[0]) {
             cloud.push(ks[0]);
         }
@@ -166,7 +173,18 @@ pub fn connect(
             }
         }
     }
-    let rows: Vec<Vec<f64>> = cloud.iter().map(|&k| graph.distances_from(k)).collect();
+    let anchor_row: HashMap<usize, &Vec<f64>> = anchor_list
+        .iter()
+        .map(|ks| ks[0])
+        .zip(&anchor_rows)
+        .collect();
+    let rows: Vec<Vec<f64>> = cloud
+        .par_iter()
+        .map(|&k| match anchor_row.get(&k) {
+            Some(row) => (*row).clone(),
+            None => graph.distances_from(k),
+        })
+        .collect();
     // Unreachable pairs are infinitely far: they never merge below any finite cut-off.
     let metric = DistanceMatrix::from_fn(cloud.len(), |a, b| {
         let d = rows[a][cloud[b]];
