@@ -78,27 +78,8 @@ impl Timings {
     }
 }
 
-/// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the
-/// world's own `seed` field, which `--seed` overrides), if there is one.
-pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
-    let path = dir.join("meta.json");
-    if !path.exists() {
-        return Ok(None);
-    }
-    let text = std::fs::read_to_string(&path).map_err(|e| PipelineError::Meta {
-        path: path.clone(),
-        message: e.to_string(),
-    })?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| PipelineError::Meta {
-            path: path.clone(),
-            message: format!("not valid JSON: {e}"),
-        })?;
-    Ok(value.get("seed").and_then(serde_json::Value::as_u64))
-}
-
-/// Reads the world a simulation ran with from its `meta.json`, if there is one.
-pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
+/// A run's `meta.json` as JSON, with its path; `None` when the directory has none.
+fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, PipelineError> {
     let path = dir.join("meta.json");
     if !path.exists() {
         return Ok(None);
@@ -108,8 +89,26 @@ pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
         message,
     };
     let text = std::fs::read_to_string(&path).map_err(|e| meta_err(e.to_string()))?;
-    let value: serde_json::Value =
+    let value =
         serde_json::from_str(&text).map_err(|e| meta_err(format!("not valid JSON: {e}")))?;
+    Ok(Some((path, value)))
+}
+
+/// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the
+/// world's own `seed` field, which `--seed` overrides), if there is one.
+pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
+    Ok(read_meta(dir)?.and_then(|(_, meta)| meta.get("seed").and_then(serde_json::Value::as_u64)))
+}
+
+/// Reads the world a simulation ran with from its `meta.json`, if there is one.
+pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
+    let Some((path, value)) = read_meta(dir)? else {
+        return Ok(None);
+    };
+    let meta_err = |message: String| PipelineError::Meta {
+        path: path.clone(),
+        message,
+    };
     let world = value
         .get("world")
         .cloned()
