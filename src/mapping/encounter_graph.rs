@@ -407,17 +407,19 @@ mod tests {
         a.0 <= b.1 && b.0 <= a.1
     }
 
-    /// The paper's graph built literally (a clique per agent), then Floyd–Warshall.
-    fn clique_metric(enc: &[Encounter], statics: &[StaticInterval]) -> Vec<Vec<f64>> {
-        let n = enc.len();
-        let mut d = vec![vec![f64::INFINITY; n]; n];
-        for i in 0..n {
-            d[i][i] = 0.0;
-            for j in 0..n {
+    /// The paper's clique edges: `(i, j, s, w)` for every ordered pair of encounters sharing
+    /// agent `s`, with the paper's weight (0 when `s` was static during an interval meeting
+    /// both).
+    fn clique_edges(
+        enc: &[Encounter],
+        statics: &[StaticInterval],
+    ) -> Vec<(usize, usize, u32, f64)> {
+        let mut edges = Vec::new();
+        for (i, x) in enc.iter().enumerate() {
+            for (j, y) in enc.iter().enumerate() {
                 if i == j {
                     continue;
                 }
-                let (x, y) = (&enc[i], &enc[j]);
                 for s in [x.a, x.b] {
                     if s != y.a && s != y.b {
                         continue;
@@ -427,11 +429,15 @@ mod tests {
                             && meets((x.start, x.end), (st.start, st.end))
                             && meets((y.start, y.end), (st.start, st.end))
                     });
-                    let w = if bridged { 0.0 } else { gap(x, y) };
-                    d[i][j] = d[i][j].min(w);
+                    edges.push((i, j, s, if bridged { 0.0 } else { gap(x, y) }));
                 }
             }
         }
+        edges
+    }
+
+    fn floyd_warshall(d: &mut [Vec<f64>]) {
+        let n = d.len();
         for k in 0..n {
             for i in 0..n {
                 for j in 0..n {
@@ -442,6 +448,19 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The paper's graph built literally (a clique per agent), then Floyd–Warshall.
+    fn clique_metric(enc: &[Encounter], statics: &[StaticInterval]) -> Vec<Vec<f64>> {
+        let n = enc.len();
+        let mut d = vec![vec![f64::INFINITY; n]; n];
+        for (i, row) in d.iter_mut().enumerate() {
+            row[i] = 0.0;
+        }
+        for (i, j, _, w) in clique_edges(enc, statics) {
+            d[i][j] = d[i][j].min(w);
+        }
+        floyd_warshall(&mut d);
         d
     }
 
@@ -526,36 +545,12 @@ mod tests {
             d[n + i][n + i] = 0.0;
             d[i][n + i] = switch;
             d[n + i][i] = switch;
-            for j in 0..n {
-                if i == j {
-                    continue;
-                }
-                let (x, y) = (&enc[i], &enc[j]);
-                for s in [x.a, x.b] {
-                    if s != y.a && s != y.b {
-                        continue;
-                    }
-                    let bridged = statics.iter().any(|st| {
-                        st.agent == s
-                            && meets((x.start, x.end), (st.start, st.end))
-                            && meets((y.start, y.end), (st.start, st.end))
-                    });
-                    let w = if bridged { 0.0 } else { gap(x, y) };
-                    let (u, v) = (half(i, s), half(j, s));
-                    d[u][v] = d[u][v].min(w);
-                }
-            }
         }
-        for k in 0..2 * n {
-            for i in 0..2 * n {
-                for j in 0..2 * n {
-                    let via = d[i][k] + d[k][j];
-                    if via < d[i][j] {
-                        d[i][j] = via;
-                    }
-                }
-            }
+        for (i, j, s, w) in clique_edges(enc, statics) {
+            let (u, v) = (half(i, s), half(j, s));
+            d[u][v] = d[u][v].min(w);
         }
+        floyd_warshall(&mut d);
         (0..n)
             .map(|i| {
                 (0..n)
