@@ -223,28 +223,36 @@ impl Row<'_> {
         Ok(v)
     }
 
-    /// A time in seconds, within ±[`MAX_TIME`].
-    fn time(&self, name: &str) -> Result<f64, String> {
+    /// A number within ±`max`; beyond it the message says `beyond ±{limit}; {hint}`.
+    fn bounded(&self, name: &str, max: f64, limit: &str, hint: &str) -> Result<f64, String> {
         let v = self.f64(name)?;
-        if v.abs() > MAX_TIME {
+        if v.abs() > max {
             return Err(format!(
-                "column `{name}` is `{}`, beyond ±1e12 s (about 31 700 years); times are seconds (milliseconds or nanoseconds since an epoch? divide by 1e3 or 1e9)",
+                "column `{name}` is `{}`, beyond ±{limit}; {hint}",
                 self.text(name).unwrap_or("")
             ));
         }
         Ok(v)
     }
 
+    /// A time in seconds, within ±[`MAX_TIME`].
+    fn time(&self, name: &str) -> Result<f64, String> {
+        self.bounded(
+            name,
+            MAX_TIME,
+            "1e12 s (about 31 700 years)",
+            "times are seconds (milliseconds or nanoseconds since an epoch? divide by 1e3 or 1e9)",
+        )
+    }
+
     /// A position in metres, within ±[`MAX_POSITION`].
     fn position(&self, name: &str) -> Result<f64, String> {
-        let v = self.f64(name)?;
-        if v.abs() > MAX_POSITION {
-            return Err(format!(
-                "column `{name}` is `{}`, beyond ±1e9 m; positions are metres in the arena's frame",
-                self.text(name).unwrap_or("")
-            ));
-        }
-        Ok(v)
+        self.bounded(
+            name,
+            MAX_POSITION,
+            "1e9 m",
+            "positions are metres in the arena's frame",
+        )
     }
 
     fn agent(&self, name: &str) -> Result<AgentId, String> {
