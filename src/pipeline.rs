@@ -9,16 +9,21 @@ use crate::io::write_atomic;
 use crate::log::{EncounterLog, LogError};
 use crate::mapping::classify::Classifier;
 use crate::mapping::local::LocalMap;
+use crate::mapping::local::local_map;
+use crate::mapping::output::WindowSummary;
 use crate::mapping::output::{
     ConnectionSummary, GlobalSummary, Summary, connection_json, window_json,
 };
-use crate::mapping::pipeline::{MapConfig, map_windows, summarise};
+use crate::mapping::pipeline::{MapConfig, summarise_window};
 use crate::mapping::stitch::{Connection, GlobalMap, StitchParams, connect, global_map};
+use crate::mapping::windows::Window;
 use crate::sim::{SimError, SimOptions, SimOutput, simulate, write_run};
 use crate::world::{World, WorldError, WorldSpec};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -129,24 +134,103 @@ pub fn map_log(
     seed: Option<u64>,
     timings: &mut Timings,
 ) -> Result<Mapped, PipelineError> {
-    let maps = timings.time("local maps", || map_windows(log, cfg));
     let windows = cfg.windows();
-    // Consecutive pairs are independent: stitch them in parallel (collected in order, so
-    // the result does not depend on the number of threads).
+    let done = Partial::new(windows.len());
+    finish(log, world, cfg, stitch, seed, &windows, done, timings)
+}
+
+/// Work done on prefixes of the log before the final log existed (module docs of
+/// [`run_world`]); every entry is what [`finish`] would compute from the final log.
+struct Partial {
+    maps: Vec<Option<LocalMap>>,
+    summaries: Vec<Option<WindowSummary>>,
+    /// `connections[k]` joins windows `k` and `k + 1` (0-based).
+    connections: Vec<Option<Connection>>,
+    free: Option<FreeSpace>,
+}
+
+impl Partial {
+    fn new(windows: usize) -> Self {
+        Self {
+            maps: (0..windows).map(|_| None).collect(),
+            summaries: vec![None; windows],
+            connections: (0..windows.saturating_sub(1)).map(|_| None).collect(),
+            free: None,
+        }
+    }
+}
+
+/// The connection between windows `k` and `k + 1` (0-based) of `windows`.
+fn connect_pair(
+    log: &EncounterLog,
+    windows: &[Window],
+    k: usize,
+    maps: [&LocalMap; 2],
+    cfg: &MapConfig,
+    stitch: &StitchParams,
+) -> Connection {
+    connect(
+        log,
+        &windows[k],
+        &windows[k + 1],
+        maps[0],
+        maps[1],
+        &cfg.local,
+        stitch,
+    )
+}
+
+/// Completes the mapping of the final `log`: whatever `done` lacks is computed here
+/// (windows and consecutive pairs in parallel, collected in order, so the result depends
+/// neither on the number of threads nor on what `done` held).
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    log: &EncounterLog,
+    world: Option<&World>,
+    cfg: &MapConfig,
+    stitch: &StitchParams,
+    seed: Option<u64>,
+    windows: &[Window],
+    done: Partial,
+    timings: &mut Timings,
+) -> Result<Mapped, PipelineError> {
+    let Partial {
+        maps,
+        summaries,
+        connections,
+        free,
+    } = done;
+    let maps: Vec<LocalMap> = timings.time("local maps", || {
+        maps.into_par_iter()
+            .zip(windows)
+            .map(|(m, w)| m.unwrap_or_else(|| local_map(log, w, &cfg.local)))
+            .collect()
+    });
     let connections: Vec<Connection> = timings.time("stitching", || {
-        let pairs: Vec<_> = windows.windows(2).zip(maps.windows(2)).collect();
-        pairs
-            .par_iter()
-            .map(|(w, m)| connect(log, &w[0], &w[1], &m[0], &m[1], &cfg.local, stitch))
+        connections
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, c)| {
+                c.unwrap_or_else(|| {
+                    connect_pair(log, windows, k, [&maps[k], &maps[k + 1]], cfg, stitch)
+                })
+            })
             .collect()
     });
     let global = timings.time("stitching", || global_map(&maps, &connections, log));
-    let truth = match world {
-        Some(w) => Some((w, timings.time("evaluation", || FreeSpace::for_world(w))?)),
-        None => None,
+    let truth = match (world, free) {
+        (Some(w), Some(f)) => Some((w, f)),
+        (Some(w), None) => Some((w, timings.time("evaluation", || FreeSpace::for_world(w))?)),
+        (None, _) => None,
     };
     let (windows_summary, connections_summary, global_truth) = timings.time("evaluation", || {
-        let ws = summarise(&maps, log, truth.as_ref().map(|(w, f)| (*w, f)));
+        let ws: Vec<WindowSummary> = summaries
+            .into_par_iter()
+            .zip(&maps)
+            .map(|(s, m)| {
+                s.unwrap_or_else(|| summarise_window(m, log, truth.as_ref().map(|(w, f)| (*w, f))))
+            })
+            .collect();
         let cs = connections
             .iter()
             .zip(windows.windows(2))
@@ -174,6 +258,7 @@ pub fn map_log(
             gluing_cycles: global.gluing_cycles,
         },
         timings: timings.0.clone(),
+        alongside: BTreeMap::new(),
     };
     Ok(Mapped {
         maps,
@@ -225,9 +310,41 @@ pub struct RunOptions<'a> {
     pub out: Option<PathBuf>,
     pub trajectories: Option<f64>,
     pub progress: Option<&'a dyn Fn(f64)>,
+    /// Map each window on the other cores while the simulation goes on, as soon as its
+    /// part of the log is final ([`run_world`]); the outputs are the same either way.
+    /// Worth it for one run on a machine with idle cores; `swarmmap eval`, which runs
+    /// many simulations side by side, leaves it off.
+    pub alongside: bool,
 }
 
 /// Simulates a world and maps its log: `swarmmap run` without the printing.
+///
+/// # Mapping while the simulation runs
+///
+/// The simulation is one thread; with [`RunOptions::alongside`] (and more than one core)
+/// a second thread maps while it runs. The simulator hands out the log's prefix at the
+/// end `c` of each window as soon as every encounter that started by `c` has ended
+/// ([`SimOptions::with_prefixes`]); on it the worker maps the window, computes its
+/// summary line (truth and fidelity) and, with the previous window's map, their
+/// connection, and it rasterises the world's free space first. The rest (windows whose
+/// prefix came too late, the last window, the last connection, the global map) is done
+/// from the final log once the simulation ends.
+///
+/// Why a prefix gives the same local map as the final log: a window ending at `c` reads
+/// the encounters that meet it, all of which started by `c`, are in the prefix exactly as
+/// in the final log and at the same indices (the prefix is the final log's first
+/// encounters, which are sorted by start). Of the static intervals it reads which
+/// encounters each meets (`s.start <= e.end && e.start <= s.end`), whether it meets the
+/// window, and along an agent's time line the gaps `start − end` between consecutive
+/// items and which of two ends is later. A static interval still running at the prefix's
+/// time `t` ends, in the prefix, at `t + dt`, and in truth no earlier: both are later
+/// than every encounter end in the prefix (all ≤ t), so each of these comparisons comes
+/// out the same (a gap after such an interval is negative either way, clamped to 0; an
+/// agent has at most one running interval, and its other intervals ended by `t`). The
+/// connection of windows `c'` < `c` reads the encounters and static intervals that meet
+/// their union, which ends at `c`, and whether a landmark's interval ends by `c'`: the
+/// same argument. The fidelity reads the truth columns of the window's own encounters.
+/// `tests/pipeline_cli.rs` checks the outputs byte for byte against mapping the final log.
 pub fn run_world(
     world: &World,
     opts: &RunOptions<'_>,
@@ -240,25 +357,123 @@ pub fn run_world(
     if let Some(p) = opts.progress {
         sim_opts = sim_opts.with_progress(p);
     }
-    let out = timings.time("simulation", || simulate(world, &sim_opts))?;
-    if let Some(dir) = &opts.out {
-        timings.time("writing", || write_run(dir, world, &out))?;
-    }
     let cfg = MapConfig::for_world(world);
     let stitch = StitchParams {
         cutoff: world.mapping.cluster_cutoff,
         neighbours: world.mapping.neighbours,
     };
-    let mapped = map_log(
+    let windows = cfg.windows();
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let (out, done, alongside) = if opts.alongside && cores > 1 && windows.len() > 1 {
+        simulate_alongside(
+            world,
+            sim_opts,
+            &cfg,
+            &stitch,
+            &windows,
+            cores - 1,
+            &mut timings,
+        )?
+    } else {
+        let out = timings.time("simulation", || simulate(world, &sim_opts))?;
+        (out, Partial::new(windows.len()), Timings::default())
+    };
+    if let Some(dir) = &opts.out {
+        timings.time("writing", || write_run(dir, world, &out))?;
+    }
+    let mut mapped = finish(
         &out.log,
         Some(world),
         &cfg,
         &stitch,
         Some(opts.seed),
+        &windows,
+        done,
         &mut timings,
     )?;
+    mapped.summary.alongside = alongside.0;
     if let Some(dir) = &opts.out {
         write_maps(dir, &out.log, &mapped)?;
     }
     Ok((out, mapped))
+}
+
+/// Runs the simulation on this thread while a worker with a pool of `threads` threads
+/// maps each window's prefix ([`run_world`], "Mapping while the simulation runs").
+/// Returns the simulation, what the worker finished, and the worker's busy time per stage.
+fn simulate_alongside(
+    world: &World,
+    sim_opts: SimOptions<'_>,
+    cfg: &MapConfig,
+    stitch: &StitchParams,
+    windows: &[Window],
+    threads: usize,
+    timings: &mut Timings,
+) -> Result<(SimOutput, Partial, Timings), PipelineError> {
+    let cuts: Vec<f64> = windows.iter().map(|w| w.end).collect();
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = mpsc::channel::<(usize, EncounterLog)>();
+    std::thread::scope(|scope| {
+        let stop = &stop;
+        let worker = scope.spawn(move || {
+            let work = move || map_prefixes(rx, stop, world, cfg, stitch, windows);
+            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pool.install(work),
+                Err(_) => work(),
+            }
+        });
+        let hand_out = |k: usize, log: EncounterLog| {
+            // The worker only stops receiving once the simulation has ended.
+            let _ = tx.send((k, log));
+        };
+        let sim = timings.time("simulation", || {
+            simulate(world, &sim_opts.with_prefixes(&cuts, &hand_out))
+        });
+        stop.store(true, Ordering::Relaxed);
+        drop(tx);
+        // Waiting for the worker's task in progress counts as mapping time.
+        let (done, busy) = timings.time("local maps", || {
+            worker
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        });
+        Ok((sim?, done, busy))
+    })
+}
+
+/// The worker of [`simulate_alongside`]: the free-space raster, then for each prefix as it
+/// comes its window's map, summary line and connection with the previous window, until the
+/// channel closes or `stop` is set (what is left is done from the final log).
+fn map_prefixes(
+    rx: mpsc::Receiver<(usize, EncounterLog)>,
+    stop: &AtomicBool,
+    world: &World,
+    cfg: &MapConfig,
+    stitch: &StitchParams,
+    windows: &[Window],
+) -> (Partial, Timings) {
+    let mut busy = Timings::default();
+    let mut done = Partial::new(windows.len());
+    // An error is left for the final pass to compute again and report.
+    done.free = busy.time("evaluation", || FreeSpace::for_world(world)).ok();
+    while let Ok((k, log)) = rx.recv() {
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+        let map = busy.time("local maps", || local_map(&log, &windows[k], &cfg.local));
+        if let Some(free) = &done.free {
+            let line = busy.time("evaluation", || {
+                summarise_window(&map, &log, Some((world, free)))
+            });
+            done.summaries[k] = Some(line);
+        }
+        if let Some(Some(previous)) = k.checked_sub(1).map(|j| done.maps[j].as_ref()) {
+            let c = busy.time("stitching", || {
+                connect_pair(&log, windows, k - 1, [previous, &map], cfg, stitch)
+            });
+            done.connections[k - 1] = Some(c);
+        }
+        done.maps[k] = Some(map);
+    }
+    (done, busy)
 }

@@ -17,10 +17,13 @@ fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
 
-/// `summary.json` without its `timings`, the only part that depends on the machine.
+/// `summary.json` without its `timings` and `alongside`, the only parts that depend on
+/// the machine.
 fn summary_without_timings(dir: &Path) -> serde_json::Value {
     let mut v = json(&dir.join("summary.json"));
-    v.as_object_mut().unwrap().remove("timings");
+    let o = v.as_object_mut().unwrap();
+    o.remove("timings");
+    o.remove("alongside");
     v
 }
 

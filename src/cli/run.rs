@@ -53,6 +53,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
                 .unwrap_or_else(|| swarmmap::report::default_trajectory_interval(&world)),
         ),
         progress: Some(&report),
+        alongside: true,
     };
     let result = run_world(&world, &opts);
     if let Some(b) = &bar {

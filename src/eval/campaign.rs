@@ -96,6 +96,7 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
             out: None,
             trajectories: None,
             progress: None,
+            alongside: false,
         };
         let (_, mapped) = run_world(&world, &opts).map_err(|e| e.to_string())?;
         Ok(mapped.summary)

@@ -270,6 +270,101 @@ impl EncounterGraph {
         dist
     }
 
+    /// Dijkstra from encounter `source` that calls `visit(j, d)` once per reached encounter
+    /// `j`, in order of its distance `d` (the same distance as [`Self::distances_from`]'s:
+    /// an encounter's distance is final when the first of its vertices pops), and stops
+    /// as soon as `visit` returns `false`.
+    fn settle_from(&self, source: usize, mut visit: impl FnMut(usize, f64) -> bool) {
+        let mut dist = vec![f64::INFINITY; self.vertices()];
+        let mut reached = vec![false; self.encounters];
+        let mut heap = RadixHeap::new();
+        let n = self.encounters;
+        let sources = [Some(source), self.halves.then_some(n + source)];
+        for v in sources.into_iter().flatten() {
+            dist[v] = 0.0;
+            heap.push(0f64.to_bits(), v as u32);
+        }
+        while let Some((bits, u)) = heap.pop() {
+            let d = f64::from_bits(bits);
+            let u = u as usize;
+            if d > dist[u] {
+                continue;
+            }
+            let encounter = if u < n {
+                Some(u)
+            } else if self.halves && u < 2 * n {
+                Some(u - n)
+            } else {
+                None
+            };
+            if let Some(j) = encounter
+                && !reached[j]
+            {
+                reached[j] = true;
+                if !visit(j, d) {
+                    return;
+                }
+            }
+            for k in self.offsets[u]..self.offsets[u + 1] {
+                let v = self.targets[k] as usize;
+                let nd = d + self.weights[k];
+                if nd < dist[v] {
+                    dist[v] = nd;
+                    heap.push(nd.to_bits(), v as u32);
+                }
+            }
+        }
+    }
+
+    /// Shortest-path distances from encounter `source` to each of `targets` (encounter
+    /// indices), as [`Self::distances_from`] gives them, stopping once every target is
+    /// reached: a stitching cloud's points lie close together in a large graph.
+    pub fn distances_to(&self, source: usize, targets: &[usize]) -> Vec<f64> {
+        let mut slot: HashMap<usize, Vec<usize>> = HashMap::new();
+        for (k, &t) in targets.iter().enumerate() {
+            slot.entry(t).or_default().push(k);
+        }
+        let mut out = vec![f64::INFINITY; targets.len()];
+        let mut left = slot.len();
+        if left == 0 {
+            return out;
+        }
+        self.settle_from(source, |j, d| {
+            if let Some(ks) = slot.get(&j) {
+                for &k in ks {
+                    out[k] = d;
+                }
+                left -= 1;
+            }
+            left > 0
+        });
+        out
+    }
+
+    /// The `k` encounters nearest to `source` at a positive finite distance, nearest
+    /// first, ties by index: the first `k` of all encounters sorted by
+    /// ([`Self::distances_from`], index), without running Dijkstra over the whole graph.
+    pub fn nearest(&self, source: usize, k: usize) -> Vec<usize> {
+        let mut found: Vec<(f64, usize)> = Vec::new();
+        if k == 0 {
+            return Vec::new();
+        }
+        self.settle_from(source, |j, d| {
+            if d <= 0.0 {
+                return true;
+            }
+            // After k, only ties with the k-th distance can still be among the first k.
+            if found.len() >= k && d > found[k - 1].0 {
+                return false;
+            }
+            found.push((d, j));
+            true
+        });
+        found.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        found.truncate(k);
+        found.into_iter().map(|(_, j)| j).collect()
+    }
+
     /// Connected components of the encounter vertices: a label per encounter, labels
     /// numbered by first appearance.
     pub fn components(&self) -> Vec<usize> {
@@ -506,6 +601,42 @@ mod tests {
             })
             .collect();
         (enc, statics)
+    }
+
+    /// The early-stopping runs give exactly (bit for bit) what the full run gives: the
+    /// distances to chosen targets, and the k nearest by (distance, index), on graphs with
+    /// and without switch costs, zero-length encounters, exact ties and unreachable parts.
+    #[test]
+    fn early_stopping_runs_match_the_full_run() {
+        for seed in 0..30 {
+            let (enc, statics) = random_log(100 + seed, 60, 8);
+            for switch in [0.0, 1.5] {
+                let g = EncounterGraph::build_switching(&enc, &statics, Bridging::Paper, switch);
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                for source in 0..enc.len() {
+                    let full = g.distances_from(source);
+                    let targets: Vec<usize> = (0..rng.random_range(0..12))
+                        .map(|_| rng.random_range(0..enc.len()))
+                        .collect();
+                    let got = g.distances_to(source, &targets);
+                    for (t, d) in targets.iter().zip(&got) {
+                        assert_eq!(full[*t].to_bits(), d.to_bits(), "seed {seed} {source}->{t}");
+                    }
+                    for k in [0, 1, 5, 80] {
+                        let mut want: Vec<usize> = (0..enc.len())
+                            .filter(|&j| full[j].is_finite() && full[j] > 0.0)
+                            .collect();
+                        want.sort_by(|&x, &y| full[x].total_cmp(&full[y]).then(x.cmp(&y)));
+                        want.truncate(k);
+                        assert_eq!(
+                            g.nearest(source, k),
+                            want,
+                            "seed {seed} source {source} k {k}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -74,8 +74,12 @@ pub struct Summary {
     pub windows: Vec<WindowSummary>,
     pub connections: Vec<ConnectionSummary>,
     pub global: GlobalSummary,
-    /// Seconds spent in each stage.
+    /// Seconds spent in each stage, wall clock, one after another (they add up to the run).
     pub timings: BTreeMap<String, f64>,
+    /// Seconds of each stage's work done on other cores while the simulation ran
+    /// (`swarmmap run`; not part of `timings`' total).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub alongside: BTreeMap<String, f64>,
 }
 
 /// An event of a window as written in `window_<i>.json`.
@@ -339,6 +343,17 @@ impl Summary {
             .map(|(k, v)| format!("{k} {v:.2} s ({:.0} %)", 100.0 * v / total.max(1e-12)))
             .collect();
         s.push_str(&format!("time: {total:.2} s = {}\n", parts.join(", ")));
+        if !self.alongside.is_empty() {
+            let parts: Vec<String> = self
+                .alongside
+                .iter()
+                .map(|(k, v)| format!("{k} {v:.2} s"))
+                .collect();
+            s.push_str(&format!(
+                "alongside the simulation, on another core: {}\n",
+                parts.join(", ")
+            ));
+        }
         s
     }
 }

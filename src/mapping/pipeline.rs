@@ -151,26 +151,33 @@ pub fn summarise(
     // Windows are independent (the fidelity reruns the topology stage on true positions):
     // in parallel, collected in order.
     maps.par_iter()
-        .map(|m| {
-            let band = truth.map(|(w, _)| window_band(w, m.start, m.end));
-            let diagonal = match (truth, band) {
-                (Some((w, _)), Some((a, b))) => (b - a).hypot(w.arena.height),
-                _ => 0.0,
-            };
-            WindowSummary {
-                index: m.index,
-                start: m.start,
-                end: m.end,
-                events: m.events.len(),
-                betti: m.betti,
-                truth: truth
-                    .zip(band)
-                    .map(|((_, fs), (a, b))| fs.betti_in_band(a, b)),
-                domain: band.map(|(a, b)| [a, b]),
-                fidelity: fidelity(m, log, diagonal),
-            }
-        })
+        .map(|m| summarise_window(m, log, truth))
         .collect()
+}
+
+/// The summary line of one window; with a world, its truth and fidelity too.
+pub fn summarise_window(
+    m: &LocalMap,
+    log: &EncounterLog,
+    truth: Option<(&World, &FreeSpace)>,
+) -> WindowSummary {
+    let band = truth.map(|(w, _)| window_band(w, m.start, m.end));
+    let diagonal = match (truth, band) {
+        (Some((w, _)), Some((a, b))) => (b - a).hypot(w.arena.height),
+        _ => 0.0,
+    };
+    WindowSummary {
+        index: m.index,
+        start: m.start,
+        end: m.end,
+        events: m.events.len(),
+        betti: m.betti,
+        truth: truth
+            .zip(band)
+            .map(|((_, fs), (a, b))| fs.betti_in_band(a, b)),
+        domain: band.map(|(a, b)| [a, b]),
+        fidelity: fidelity(m, log, diagonal),
+    }
 }
 
 #[cfg(test)]

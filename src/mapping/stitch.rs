@@ -153,41 +153,32 @@ pub fn connect(
     let mut cloud: Vec<usize> = Vec::new();
     let mut seen = BTreeSet::new();
     // One shortest-path run per anchor and per cloud point, each independent: in parallel,
-    // collected in order.
+    // collected in order. Each stops early ([`EncounterGraph::nearest`],
+    // [`EncounterGraph::distances_to`]) with the distances a full run would give.
     let anchor_list: Vec<&Vec<usize>> = anchors.values().collect();
-    let anchor_rows: Vec<Vec<f64>> = anchor_list
+    let nearest: Vec<Vec<usize>> = anchor_list
         .par_iter()
-        .map(|ks| graph.distances_from(ks[0]))
+        .map(|ks| graph.nearest(ks[0], p.neighbours))
         .collect();
-    for (ks, row) in anchor_list.iter().zip(&anchor_rows) {
+    for (ks, near) in anchor_list.iter().zip(&nearest) {
         if seen.insert(ks[0]) {
             cloud.push(ks[0]);
         }
-        let mut near: Vec<usize> = (0..enc.len())
-            .filter(|j| row[*j].is_finite() && row[*j] > 0.0)
-            .collect();
-        near.sort_by(|&x, &y| row[x].total_cmp(&row[y]).then(x.cmp(&y)));
-        for &j in near.iter().take(p.neighbours) {
+        for &j in near {
             if seen.insert(j) {
                 cloud.push(j);
             }
         }
     }
-    let anchor_row: HashMap<usize, &Vec<f64>> = anchor_list
-        .iter()
-        .map(|ks| ks[0])
-        .zip(&anchor_rows)
-        .collect();
-    let rows: Vec<Vec<f64>> = cloud
-        .par_iter()
-        .map(|&k| match anchor_row.get(&k) {
-            Some(row) => (*row).clone(),
-            None => graph.distances_from(k),
-        })
+    // The metric's entry (a, b), a < b, is the run from a's distance to b: each run needs
+    // only the points after its own.
+    let rows: Vec<Vec<f64>> = (0..cloud.len())
+        .into_par_iter()
+        .map(|a| graph.distances_to(cloud[a], &cloud[a + 1..]))
         .collect();
     // Unreachable pairs are infinitely far: they never merge below any finite cut-off.
     let metric = DistanceMatrix::from_fn(cloud.len(), |a, b| {
-        let d = rows[a][cloud[b]];
+        let d = rows[a][b - a - 1];
         if d.is_finite() { d } else { f64::MAX }
     });
     let dendrogram = single_linkage(&metric);

@@ -95,8 +95,16 @@ fn summary_tables(run: &RunData) -> String {
     }
     let _ = writeln!(
         h,
-        "<tr><td><b>total</b></td><td><b>{total:.2}</b></td><td></td></tr>\n</tbody></table>"
+        "<tr><td><b>total</b></td><td><b>{total:.2}</b></td><td></td></tr>"
     );
+    for (k, v) in &s.alongside {
+        let _ = writeln!(
+            h,
+            "<tr><td>{} (alongside the simulation, another core)</td><td>{v:.2}</td><td></td></tr>",
+            escape(k)
+        );
+    }
+    h.push_str("</tbody></table>\n");
     h
 }
 

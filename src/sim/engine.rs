@@ -715,6 +715,57 @@ impl Run<'_> {
     }
 }
 
+/// The final log's order of encounters: by start, then agents.
+fn encounter_order(x: &Encounter, y: &Encounter) -> std::cmp::Ordering {
+    x.start
+        .total_cmp(&y.start)
+        .then(x.a.cmp(&y.a))
+        .then(x.b.cmp(&y.b))
+}
+
+/// The final log's order of static intervals: by agent, then start and end.
+fn static_order(x: &StaticInterval, y: &StaticInterval) -> std::cmp::Ordering {
+    x.agent
+        .cmp(&y.agent)
+        .then(x.start.total_cmp(&y.start))
+        .then(x.end.total_cmp(&y.end))
+}
+
+impl Run<'_> {
+    /// The log's prefix up to the cut `c` ([`SimOptions::with_prefixes`]); static
+    /// intervals still running end at `cut_off`.
+    fn prefix(&self, c: f64, cut_off: f64) -> EncounterLog {
+        let mut encounters: Vec<Encounter> = self
+            .log
+            .encounters
+            .iter()
+            .filter(|e| e.start <= c)
+            .cloned()
+            .collect();
+        encounters.sort_by(encounter_order);
+        let mut static_intervals = self.log.static_intervals.clone();
+        for (i, a) in self.agents.iter().enumerate() {
+            let reason = match a.state {
+                AgentState::Pause => StaticReason::Pause,
+                AgentState::Landmark => StaticReason::Landmark,
+                _ => continue,
+            };
+            static_intervals.push(StaticInterval {
+                agent: i as AgentId,
+                start: a.static_since,
+                end: cut_off,
+                reason,
+            });
+        }
+        static_intervals.sort_by(static_order);
+        EncounterLog {
+            encounters,
+            static_intervals,
+            leader: self.log.leader.clone(),
+        }
+    }
+}
+
 /// Runs the swarm through the whole sweep of `world` (dispersion, then the leader from
 /// `start_x` to `end_x`) and returns the encounter log.
 ///
@@ -759,6 +810,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     let mut events = Vec::new();
     let mut physics_time = 0.0;
     let mut landmark_time = 0.0;
+    let mut next_cut = 0;
     for k in 0..=n_steps {
         let t = k as f64 * dt;
         if let Some(i) = scene.read_positions(&mut pos) {
@@ -823,6 +875,15 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         if last {
             break;
         }
+        if let Some((cuts, hand_out)) = opts.prefixes {
+            while let Some(&c) = cuts.get(next_cut) {
+                if t < c || run.open.values().any(|&(start, _)| start <= c) {
+                    break;
+                }
+                hand_out(next_cut, run.prefix(c, t + dt));
+                next_cut += 1;
+            }
+        }
         if let Some(report) = opts.progress
             && k % progress_every == 0
         {
@@ -850,18 +911,8 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         }
     }
     let mut log = run.log;
-    log.encounters.sort_by(|x, y| {
-        x.start
-            .total_cmp(&y.start)
-            .then(x.a.cmp(&y.a))
-            .then(x.b.cmp(&y.b))
-    });
-    log.static_intervals.sort_by(|x, y| {
-        x.agent
-            .cmp(&y.agent)
-            .then(x.start.total_cmp(&y.start))
-            .then(x.end.total_cmp(&y.end))
-    });
+    log.encounters.sort_by(encounter_order);
+    log.static_intervals.sort_by(static_order);
     if let Some(report) = opts.progress {
         report(1.0);
     }

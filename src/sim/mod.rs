@@ -46,5 +46,6 @@ pub use output::{
     write_run,
 };
 pub use params::{
-    AgentState, SimError, SimOptions, SimOutput, SimStats, Trajectories, TrajectorySample,
+    AgentState, PrefixSink, SimError, SimOptions, SimOutput, SimStats, Trajectories,
+    TrajectorySample,
 };

@@ -3,6 +3,9 @@
 use crate::log::{AgentId, EncounterLog};
 use std::path::PathBuf;
 
+/// Where [`SimOptions::with_prefixes`] hands a prefix: its cut's index and the log.
+pub type PrefixSink<'a> = dyn Fn(usize, EncounterLog) + 'a;
+
 /// Options of one run that are not part of the world.
 #[derive(Clone, Copy)]
 pub struct SimOptions<'a> {
@@ -13,6 +16,9 @@ pub struct SimOptions<'a> {
     pub trajectories: Option<f64>,
     /// Called now and then with the fraction of the run done, in `[0, 1]`.
     pub progress: Option<&'a dyn Fn(f64)>,
+    /// Cut times (ascending) and where to hand the log's prefixes: see
+    /// [`SimOptions::with_prefixes`].
+    pub prefixes: Option<(&'a [f64], &'a PrefixSink<'a>)>,
 }
 
 impl<'a> SimOptions<'a> {
@@ -23,6 +29,7 @@ impl<'a> SimOptions<'a> {
             seed,
             trajectories: None,
             progress: None,
+            prefixes: None,
         }
     }
 
@@ -37,6 +44,28 @@ impl<'a> SimOptions<'a> {
     #[must_use]
     pub fn with_progress(mut self, f: &'a dyn Fn(f64)) -> Self {
         self.progress = Some(f);
+        self
+    }
+
+    /// Hands out the final log's prefixes while the run goes on: for each cut time `c` of
+    /// `cuts` (ascending), as soon as the simulation has passed `c` and every encounter
+    /// that started at or before `c` has ended, `f(k, log)` is called (`k` indexes `cuts`)
+    /// with a log that holds
+    /// - every encounter that started at or before `c`, exactly as the final log will have
+    ///   it and in its order (so an index into it is an index into the final log);
+    /// - every static interval that has started, as in the final log, except that one still
+    ///   running is cut off one time step after the current time `t` (its true end lies at
+    ///   or after that step): later than every encounter end in the prefix, as its true end is;
+    /// - the leader's positions so far.
+    ///
+    /// A cut that only the end of the run settles is not handed out: the final log serves.
+    /// Anything that reads only the encounters that meet `[.., c]`, and of the static
+    /// intervals only how their ends compare with those encounters' times, gives the same
+    /// answer on the prefix as on the final log (the local maps and connections of windows
+    /// ending at `c`, `crate::pipeline`).
+    #[must_use]
+    pub fn with_prefixes(mut self, cuts: &'a [f64], f: &'a PrefixSink<'a>) -> Self {
+        self.prefixes = Some((cuts, f));
         self
     }
 }

@@ -1,0 +1,94 @@
+//! Mapping while the simulation runs (`pipeline::run_world`, "Mapping while the simulation
+//! runs") must write exactly what mapping the final log writes: the local maps, their
+//! summaries and the connections computed from the log's prefixes are compared byte for
+//! byte with those of the same run mapped after the simulation.
+
+use std::fs;
+use std::path::Path;
+use swarmmap::pipeline::{RunOptions, run_world};
+use swarmmap::world::{WorldSpec, apply_assignment};
+
+const TINY: &str = "tests/fixtures/worlds/tiny.ron";
+
+/// Every file a run writes, `summary.json` without its wall-clock parts.
+fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    for sub in ["", "maps"] {
+        let mut names: Vec<_> = fs::read_dir(dir.join(sub))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.is_file())
+            .collect();
+        names.sort();
+        for path in names {
+            let name = path.strip_prefix(dir).unwrap().display().to_string();
+            let mut bytes = fs::read(&path).unwrap();
+            if name == "summary.json" {
+                let mut v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+                let o = v.as_object_mut().unwrap();
+                o.remove("timings");
+                o.remove("alongside");
+                bytes = serde_json::to_vec(&v).unwrap();
+            }
+            if name == "meta.json" {
+                // Wall-clock timings of the simulation.
+                let mut v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+                v.as_object_mut().unwrap().remove("timings");
+                bytes = serde_json::to_vec(&v).unwrap();
+            }
+            files.push((name, bytes));
+        }
+    }
+    files
+}
+
+#[test]
+fn mapping_alongside_the_simulation_writes_what_mapping_afterwards_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let variants: [&[&str]; 3] = [
+        &["mapping.windows=4"],
+        &[
+            "mapping.windows=5",
+            "mapping.method=Paper",
+            "swarm.agents=60",
+        ],
+        &["mapping.windows=3", "mapping.switch_cost=1.0", "seed=8"],
+    ];
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    for (v, sets) in variants.iter().enumerate() {
+        let mut spec = WorldSpec::load(Path::new(TINY)).unwrap();
+        for s in *sets {
+            apply_assignment(&mut spec, s).unwrap();
+        }
+        let world = spec.check().unwrap();
+        let mut dirs = Vec::new();
+        for alongside in [false, true] {
+            let dir = tmp.path().join(format!("{v}-{alongside}"));
+            let opts = RunOptions {
+                seed: world.seed,
+                out: Some(dir.clone()),
+                trajectories: None,
+                progress: None,
+                alongside,
+            };
+            let (_, mapped) = run_world(&world, &opts).unwrap();
+            if alongside && cores > 1 {
+                // The worker did map windows from prefixes (all but the last one can be).
+                let busy = mapped.summary.alongside.get("local maps").copied();
+                assert!(busy.is_some_and(|s| s > 0.0), "{sets:?}: {busy:?}");
+                assert!(mapped.summary.alongside.contains_key("stitching"));
+            } else {
+                assert!(mapped.summary.alongside.is_empty());
+            }
+            dirs.push(dir);
+        }
+        let (a, b) = (outputs(&dirs[0]), outputs(&dirs[1]));
+        assert_eq!(
+            a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+            b.iter().map(|f| &f.0).collect::<Vec<_>>()
+        );
+        for ((name, x), (_, y)) in a.iter().zip(&b) {
+            assert!(x == y, "{sets:?}: {name} differs");
+        }
+    }
+}
