@@ -22,8 +22,7 @@ use crate::world::{World, WorldError, WorldSpec};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
+use std::sync::{Mutex, mpsc};
 use std::time::Instant;
 use thiserror::Error;
 
@@ -411,12 +410,15 @@ fn simulate_alongside(
     timings: &mut Timings,
 ) -> Result<(SimOutput, Partial, Timings), PipelineError> {
     let cuts: Vec<f64> = windows.iter().map(|w| w.end).collect();
-    let stop = AtomicBool::new(false);
+    let claims = Mutex::new(Claims {
+        stop: false,
+        taken: vec![false; windows.len()],
+    });
     let (tx, rx) = mpsc::channel::<(usize, EncounterLog)>();
     std::thread::scope(|scope| {
-        let stop = &stop;
+        let claims = &claims;
         let worker = scope.spawn(move || {
-            let work = move || map_prefixes(rx, stop, world, cfg, stitch, windows);
+            let work = move || map_prefixes(rx, claims, world, cfg, stitch, windows);
             match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pool.install(work),
                 Err(_) => work(),
@@ -429,24 +431,52 @@ fn simulate_alongside(
         let sim = timings.time("simulation", || {
             simulate(world, &sim_opts.with_prefixes(&cuts, &hand_out))
         });
-        stop.store(true, Ordering::Relaxed);
+        let taken = {
+            let mut c = claims
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            c.stop = true;
+            c.taken.clone()
+        };
         drop(tx);
-        // Waiting for the worker's task in progress counts as mapping time.
-        let (done, busy) = timings.time("local maps", || {
+        // The windows the worker has not started are mapped here from the final log, while
+        // it finishes the one in progress; waiting for it counts as mapping time.
+        let mine: Vec<(usize, LocalMap)> = match &sim {
+            Ok(out) => timings.time("local maps", || {
+                windows
+                    .par_iter()
+                    .enumerate()
+                    .filter(|(k, _)| !taken[*k])
+                    .map(|(k, w)| (k, local_map(&out.log, w, &cfg.local)))
+                    .collect()
+            }),
+            Err(_) => Vec::new(),
+        };
+        let (mut done, busy) = timings.time("local maps", || {
             worker
                 .join()
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
         });
+        for (k, map) in mine {
+            done.maps[k] = Some(map);
+        }
         Ok((sim?, done, busy))
     })
 }
 
+/// Which windows the worker of [`simulate_alongside`] has started, and whether it may
+/// start another: the simulation's end sets `stop`, and the rest is the main thread's.
+struct Claims {
+    stop: bool,
+    taken: Vec<bool>,
+}
+
 /// The worker of [`simulate_alongside`]: the free-space raster, then for each prefix as it
 /// comes its window's map, summary line and connection with the previous window, until the
-/// channel closes or `stop` is set (what is left is done from the final log).
+/// channel closes or the simulation has ended (what is left is done from the final log).
 fn map_prefixes(
     rx: mpsc::Receiver<(usize, EncounterLog)>,
-    stop: &AtomicBool,
+    claims: &Mutex<Claims>,
     world: &World,
     cfg: &MapConfig,
     stitch: &StitchParams,
@@ -457,8 +487,14 @@ fn map_prefixes(
     // An error is left for the final pass to compute again and report.
     done.free = busy.time("evaluation", || FreeSpace::for_world(world)).ok();
     while let Ok((k, log)) = rx.recv() {
-        if stop.load(Ordering::Relaxed) {
-            break;
+        {
+            let mut c = claims
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if c.stop {
+                break;
+            }
+            c.taken[k] = true;
         }
         let map = busy.time("local maps", || local_map(&log, &windows[k], &cfg.local));
         if let Some(free) = &done.free {
