@@ -235,6 +235,22 @@ impl EncounterGraph {
     /// does not depend on the order in which equal keys pop (each distance is the minimum
     /// over its neighbours' final distances), so it is deterministic.
     pub fn distances_from(&self, source: usize) -> Vec<f64> {
+        let mut dist = self.dijkstra(source, |_, _| true);
+        let n = self.encounters;
+        if self.halves {
+            let (a, b) = dist.split_at_mut(n);
+            for (x, &y) in a.iter_mut().zip(&b[..n]) {
+                *x = x.min(y);
+            }
+        }
+        dist.truncate(n);
+        dist
+    }
+
+    /// Dijkstra from encounter `source` (both halves): calls `settled(u, d)` as each vertex
+    /// `u` pops at its final distance `d`, stops as soon as that returns `false`, and returns
+    /// the distances of every vertex (final for those popped).
+    fn dijkstra(&self, source: usize, mut settled: impl FnMut(usize, f64) -> bool) -> Vec<f64> {
         let mut dist = vec![f64::INFINITY; self.vertices()];
         let mut heap = RadixHeap::new();
         let n = self.encounters;
@@ -251,6 +267,9 @@ impl EncounterGraph {
             if d > dist[u] {
                 continue;
             }
+            if !settled(u, d) {
+                break;
+            }
             for k in self.offsets[u]..self.offsets[u + 1] {
                 let v = self.targets[k] as usize;
                 let nd = d + self.weights[k];
@@ -260,13 +279,6 @@ impl EncounterGraph {
                 }
             }
         }
-        if self.halves {
-            let (a, b) = dist.split_at_mut(n);
-            for (x, &y) in a.iter_mut().zip(&b[..n]) {
-                *x = x.min(y);
-            }
-        }
-        dist.truncate(n);
         dist
     }
 
@@ -275,45 +287,22 @@ impl EncounterGraph {
     /// an encounter's distance is final when the first of its vertices pops), and stops
     /// as soon as `visit` returns `false`.
     fn settle_from(&self, source: usize, mut visit: impl FnMut(usize, f64) -> bool) {
-        let mut dist = vec![f64::INFINITY; self.vertices()];
-        let mut reached = vec![false; self.encounters];
-        let mut heap = RadixHeap::new();
         let n = self.encounters;
-        let sources = [Some(source), self.halves.then_some(n + source)];
-        for v in sources.into_iter().flatten() {
-            dist[v] = 0.0;
-            heap.push(0f64.to_bits(), v as u32);
-        }
-        while let Some((bits, u)) = heap.pop() {
-            let d = f64::from_bits(bits);
-            let u = u as usize;
-            if d > dist[u] {
-                continue;
-            }
+        let mut reached = vec![false; n];
+        self.dijkstra(source, |u, d| {
             let encounter = if u < n {
-                Some(u)
+                u
             } else if self.halves && u < 2 * n {
-                Some(u - n)
+                u - n
             } else {
-                None
+                return true;
             };
-            if let Some(j) = encounter
-                && !reached[j]
-            {
-                reached[j] = true;
-                if !visit(j, d) {
-                    return;
-                }
+            if reached[encounter] {
+                return true;
             }
-            for k in self.offsets[u]..self.offsets[u + 1] {
-                let v = self.targets[k] as usize;
-                let nd = d + self.weights[k];
-                if nd < dist[v] {
-                    dist[v] = nd;
-                    heap.push(nd.to_bits(), v as u32);
-                }
-            }
-        }
+            reached[encounter] = true;
+            visit(encounter, d)
+        });
     }
 
     /// Shortest-path distances from encounter `source` to each of `targets` (encounter
