@@ -22,6 +22,7 @@ use crate::world::{World, WorldError, WorldSpec};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, mpsc};
 use std::time::Instant;
 use thiserror::Error;
@@ -316,6 +317,11 @@ pub struct RunOptions<'a> {
     pub alongside: bool,
 }
 
+/// Most windows for which [`run_world`] maps alongside the simulation: each prefix handed
+/// out is a copy of the log so far, so with many short windows the copies would cost the
+/// simulation thread more than the worker saves.
+pub const ALONGSIDE_MAX_WINDOWS: usize = 64;
+
 /// Simulates a world and maps its log: `swarmmap run` without the printing.
 ///
 /// # Mapping while the simulation runs
@@ -323,7 +329,10 @@ pub struct RunOptions<'a> {
 /// The simulation is one thread; with [`RunOptions::alongside`] (and more than one core)
 /// a second thread maps while it runs. The simulator hands out the log's prefix at the
 /// end `c` of each window as soon as every encounter that started by `c` has ended
-/// ([`SimOptions::with_prefixes`]); on it the worker maps the window, computes its
+/// ([`SimOptions::with_prefixes`]; one at a time: a prefix that comes while another still
+/// waits for the worker is not copied, and its window is left to the final pass, and with
+/// more than [`ALONGSIDE_MAX_WINDOWS`] windows nothing runs alongside); on it the worker
+/// maps the window, computes its
 /// summary line (truth and fidelity) and, with the previous window's map, their
 /// connection, and it rasterises the world's free space first. The rest (windows whose
 /// prefix came too late, the last window, the last connection, the global map) is done
@@ -363,7 +372,8 @@ pub fn run_world(
     };
     let windows = cfg.windows();
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let (out, done, alongside) = if opts.alongside && cores > 1 && windows.len() > 1 {
+    let alongside_pays = (2..=ALONGSIDE_MAX_WINDOWS).contains(&windows.len());
+    let (out, done, alongside) = if opts.alongside && cores > 1 && alongside_pays {
         simulate_alongside(
             world,
             sim_opts,
@@ -415,18 +425,25 @@ fn simulate_alongside(
         taken: vec![false; windows.len()],
     });
     let (tx, rx) = mpsc::channel::<(usize, EncounterLog)>();
+    let waiting = AtomicUsize::new(0);
     std::thread::scope(|scope| {
-        let claims = &claims;
+        let (claims, waiting) = (&claims, &waiting);
         let worker = scope.spawn(move || {
-            let work = move || map_prefixes(rx, claims, world, cfg, stitch, windows);
+            let work = move || map_prefixes(rx, waiting, claims, world, cfg, stitch, windows);
             match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pool.install(work),
                 Err(_) => work(),
             }
         });
-        let hand_out = |k: usize, log: EncounterLog| {
-            // The worker only stops receiving once the simulation has ended.
-            let _ = tx.send((k, log));
+        // At most one prefix waits for the worker: a cut that comes while one waits is left
+        // to the final pass, so the copies stay few and memory stays bounded however many
+        // windows there are.
+        let hand_out = |k: usize, build: &dyn Fn() -> EncounterLog| {
+            if waiting.load(Ordering::Acquire) == 0 {
+                waiting.fetch_add(1, Ordering::AcqRel);
+                // The worker only stops receiving once the simulation has ended.
+                let _ = tx.send((k, build()));
+            }
         };
         let sim = timings.time("simulation", || {
             simulate(world, &sim_opts.with_prefixes(&cuts, &hand_out))
@@ -476,6 +493,7 @@ struct Claims {
 /// channel closes or the simulation has ended (what is left is done from the final log).
 fn map_prefixes(
     rx: mpsc::Receiver<(usize, EncounterLog)>,
+    waiting: &AtomicUsize,
     claims: &Mutex<Claims>,
     world: &World,
     cfg: &MapConfig,
@@ -487,6 +505,7 @@ fn map_prefixes(
     // An error is left for the final pass to compute again and report.
     done.free = busy.time("evaluation", || FreeSpace::for_world(world)).ok();
     while let Ok((k, log)) = rx.recv() {
+        waiting.fetch_sub(1, Ordering::AcqRel);
         {
             let mut c = claims
                 .lock()

@@ -880,7 +880,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
                 if t < c || run.open.values().any(|&(start, _)| start <= c) {
                     break;
                 }
-                hand_out(next_cut, run.prefix(c, t + dt));
+                hand_out(next_cut, &|| run.prefix(c, t + dt));
                 next_cut += 1;
             }
         }

@@ -3,8 +3,9 @@
 use crate::log::{AgentId, EncounterLog};
 use std::path::PathBuf;
 
-/// Where [`SimOptions::with_prefixes`] hands a prefix: its cut's index and the log.
-pub type PrefixSink<'a> = dyn Fn(usize, EncounterLog) + 'a;
+/// Where [`SimOptions::with_prefixes`] offers a prefix: its cut's index and a function that
+/// builds it (a copy of the log so far, so a sink that cannot take it now should not call it).
+pub type PrefixSink<'a> = dyn Fn(usize, &dyn Fn() -> EncounterLog) + 'a;
 
 /// Options of one run that are not part of the world.
 #[derive(Clone, Copy)]
@@ -49,8 +50,8 @@ impl<'a> SimOptions<'a> {
 
     /// Hands out the final log's prefixes while the run goes on: for each cut time `c` of
     /// `cuts` (ascending), as soon as the simulation has passed `c` and every encounter
-    /// that started at or before `c` has ended, `f(k, log)` is called (`k` indexes `cuts`)
-    /// with a log that holds
+    /// that started at or before `c` has ended, `f(k, build)` is called (`k` indexes `cuts`);
+    /// `build()` returns a log that holds
     /// - every encounter that started at or before `c`, exactly as the final log will have
     ///   it and in its order (so an index into it is an index into the final log);
     /// - every static interval that has started, as in the final log, except that one still
