@@ -54,7 +54,43 @@ fn cases() -> Vec<Case> {
     let mut inside_ring = world(ring(5.0, 2.5, 1.0, 0.1));
     inside_ring.leader.start_x = 5.0;
     inside_ring.swarm.placement = Placement::Disk { radius: 0.5 };
+    // Lanes beside a corridor that opens only at x = 7 m, ahead of a swarm that starts
+    // inside it: no agent can enter them until the domain (3 m wide) reaches x = 7 m, and
+    // by then it has left x < 4 m behind.
+    let lanes = |from: f64, to: f64| {
+        vec![
+            wall((from, 2.0), (to, 2.0), 0.1),
+            wall((from, 3.0), (to, 3.0), 0.1),
+        ]
+    };
+    let mut corridor_ahead = world(lanes(0.0, 7.0));
+    corridor_ahead.swarm.placement = Placement::Disk { radius: 0.4 };
+    // The same lanes with the swarm placed over all of D(0): all three are entered at once.
+    let mut corridor_window = corridor_ahead.clone();
+    corridor_window.swarm.placement = Placement::Window;
+    // Lanes that open behind the swarm (walls from x = 4 m to the right side): it reaches
+    // all three from the open floor before the domain gets there.
+    let mut corridor_behind = world(lanes(4.0, 10.0));
+    corridor_behind.swarm.placement = Placement::Disk { radius: 0.4 };
     vec![
+        Case {
+            name: "lanes that open ahead of the swarm",
+            world: corridor_ahead,
+            global: [1, 0],
+            bands: vec![(0.0, 3.5, [1, 0]), (4.5, 10.0, [1, 0]), (4.5, 6.5, [3, 0])],
+        },
+        Case {
+            name: "the same lanes, the swarm placed over D(0)",
+            world: corridor_window,
+            global: [1, 0],
+            bands: vec![(0.0, 3.5, [3, 0]), (4.5, 6.5, [3, 0])],
+        },
+        Case {
+            name: "lanes that open behind the swarm",
+            world: corridor_behind,
+            global: [1, 0],
+            bands: vec![(5.0, 9.0, [3, 0]), (0.0, 3.5, [1, 0])],
+        },
         Case {
             name: "empty arena",
             world: world(vec![]),

@@ -7,11 +7,19 @@
 //! - **Free space F.** The positions of an agent's *centre*: points at clearance strictly
 //!   greater than the body radius r, i.e. the arena shrunk by r minus every obstacle grown
 //!   by r. A passage narrower than 2r is closed.
-//! - **Reachable free space R.** The connected components of F that contain part of the
-//!   initial placement region (`swarm.placement`: the disc of its radius around
-//!   `(leader.start_x, height / 2)`, or the initial domain D(0) for `Window`). A pocket that
-//!   no agent can enter (the inside of a ring obstacle) is not space the swarm can map, so
-//!   the ring with its pocket counts as one solid obstacle.
+//! - **Reachable free space R.** The part of F that the swarm can walk into while it stays
+//!   in the moving domain D(t) (the motion model turns back every agent that leaves it): the
+//!   points of F joined, inside D(0), to the initial placement region (`swarm.placement`:
+//!   the disc of its radius around `(leader.start_x, height / 2)`, or D(0) itself for
+//!   `Window`), and then every point joined inside some D(t) to what was reachable before.
+//!   A pocket that no agent can enter (the inside of a ring obstacle) is not space the swarm
+//!   can map, so the ring with its pocket counts as one solid obstacle; likewise a lane that
+//!   opens only ahead of the swarm, and only where the domain has already passed it (the
+//!   lanes beside `worlds/corridor.ron`'s corridor, which no agent enters before x = 17 m),
+//!   is not counted. Computed on the raster by a flood fill that follows the domain's right
+//!   edge column by column (`swept`): each cell enters once. On every other bundled and
+//!   training world R is the whole of F's components that meet the placement, as it was
+//!   before this rule (ninth session; README, "Ground truth").
 //! - **A window's truth.** The domain of window W_i = [a, b] is the band
 //!   D_i = ∪_{t∈W_i} D(t) = [domain(a).0, domain(b).1] (the leader moves monotonically; see
 //!   [`window_band`]). β0 is the number of components of R ∩ D_i. β1 counts the holes that
@@ -199,10 +207,12 @@ impl FreeSpace {
         // Components of F, then keep those meeting the placement region.
         let (f_labels, f_count) = label_4(&free, nx, ny);
         let mut seeded = vec![false; f_count];
+        let mut seeds: Vec<usize> = Vec::new();
         let mut mark = |i: usize, j: usize| {
             let l = f_labels[i * ny + j];
             if l != NONE {
                 seeded[l as usize] = true;
+                seeds.push(i * ny + j);
             }
         };
         match world.swarm.placement {
@@ -239,23 +249,12 @@ impl FreeSpace {
                 }
             }
         }
-        let mut remap = vec![NONE; f_count];
-        let mut components = 0u32;
-        let mut comp = vec![NONE; nx * ny];
-        let mut reach = vec![false; nx * ny];
-        for k in 0..nx * ny {
-            let l = f_labels[k];
-            if l == NONE || !seeded[l as usize] {
-                continue;
-            }
-            let slot = &mut remap[l as usize];
-            if *slot == NONE {
-                *slot = components;
-                components += 1;
-            }
-            comp[k] = *slot;
-            reach[k] = true;
-        }
+        let reach: Vec<bool> = f_labels
+            .iter()
+            .map(|&l| l != NONE && seeded[l as usize])
+            .collect();
+        let reach = swept(&reach, &seeds, world, h, nx, ny);
+        let (comp, components) = label_4(&reach, nx, ny);
         let holes = count_holes_8(&reach, nx, ny);
         Ok(Self {
             resolution,
@@ -264,7 +263,7 @@ impl FreeSpace {
             ny,
             reach,
             comp,
-            components: components as usize,
+            components,
             holes,
         })
     }
@@ -411,6 +410,84 @@ pub fn overlap(a: (f64, f64), b: (f64, f64)) -> Option<(f64, f64)> {
 }
 
 /// Indices k in `0..n` whose cell centres `(k + 0.5) h` lie in [lo, hi], or `None`.
+/// The cells of `reach` that the swarm can visit while it stays in the moving domain D(t):
+/// flood fill from the placement's cells `seeds` inside D(0) (the dispersion), then, as
+/// the domain's right edge passes each column, from that column's cells next to a visited
+/// one, over unvisited cells of `reach` inside the domain at that moment. A cell enters
+/// once, so the cost is O(cells) plus one pass over each column.
+fn swept(
+    reach: &[bool],
+    seeds: &[usize],
+    world: &World,
+    h: f64,
+    nx: usize,
+    ny: usize,
+) -> Vec<bool> {
+    let mut visited = vec![false; nx * ny];
+    // Columns whose centres lie in [a, b].
+    let cols = |a: f64, b: f64| -> (usize, usize) {
+        let c0 = ((a / h - 0.5).ceil().max(0.0) as usize).min(nx - 1);
+        let c1 = (((b / h - 0.5).floor()).max(0.0) as usize).min(nx - 1);
+        (c0, c1.max(c0))
+    };
+    let flood = |visited: &mut Vec<bool>, stack: &mut Vec<usize>, c0: usize, c1: usize| {
+        while let Some(k) = stack.pop() {
+            let (i, j) = (k / ny, k % ny);
+            let mut push = |ii: usize, jj: usize| {
+                let q = ii * ny + jj;
+                if ii >= c0 && ii <= c1 && reach[q] && !visited[q] {
+                    visited[q] = true;
+                    stack.push(q);
+                }
+            };
+            if i > 0 {
+                push(i - 1, j);
+            }
+            if i + 1 < nx {
+                push(i + 1, j);
+            }
+            if j > 0 {
+                push(i, j - 1);
+            }
+            if j + 1 < ny {
+                push(i, j + 1);
+            }
+        }
+    };
+    let (a0, b0) = world.domain(0.0);
+    let (c0_start, c1_start) = cols(a0, b0);
+    // The placement may reach past D(0): its agents start there and walk back into it.
+    let (mut lo, mut hi) = (c0_start, c1_start);
+    let mut stack: Vec<usize> = Vec::new();
+    for &k in seeds {
+        if reach[k] && !visited[k] {
+            visited[k] = true;
+            stack.push(k);
+            lo = lo.min(k / ny);
+            hi = hi.max(k / ny);
+        }
+    }
+    flood(&mut visited, &mut stack, lo, hi);
+    let (mut c0, mut c1) = (c0_start, c1_start);
+    let (_, b_end) = world.domain(world.total_duration());
+    let (_, last) = cols(b_end, b_end);
+    let width = b0 - a0;
+    while c1 < last {
+        c1 += 1;
+        let right = (c1 as f64 + 0.5) * h;
+        c0 = cols(right - width, right).0.max(c0);
+        for j in 0..ny {
+            let k = c1 * ny + j;
+            if reach[k] && !visited[k] && visited[k - ny] {
+                visited[k] = true;
+                stack.push(k);
+            }
+        }
+        flood(&mut visited, &mut stack, c0, c1);
+    }
+    visited
+}
+
 fn index_range(lo: f64, hi: f64, h: f64, n: usize) -> Option<(usize, usize)> {
     // `f64::max` would turn a NaN bound into 0: reject it first.
     if lo.is_nan() || hi.is_nan() || n == 0 {
