@@ -352,7 +352,7 @@ pub const ALONGSIDE_MAX_WINDOWS: usize = 64;
 /// connection of windows `c'` < `c` reads the encounters and static intervals that meet
 /// their union, which ends at `c`, and whether a landmark's interval ends by `c'`: the
 /// same argument. The fidelity reads the truth columns of the window's own encounters.
-/// `tests/pipeline_cli.rs` checks the outputs byte for byte against mapping the final log.
+/// `tests/alongside.rs` checks the outputs byte for byte against mapping the final log.
 pub fn run_world(
     world: &World,
     opts: &RunOptions<'_>,

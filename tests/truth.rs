@@ -72,7 +72,18 @@ fn cases() -> Vec<Case> {
     // all three from the open floor before the domain gets there.
     let mut corridor_behind = world(lanes(4.0, 10.0));
     corridor_behind.swarm.placement = Placement::Disk { radius: 0.4 };
+    // The first case mirrored: a leftward sweep from x = 8.5 m, lanes open at x = 3 m.
+    let mut corridor_leftward = world(lanes(3.0, 10.0));
+    corridor_leftward.swarm.placement = Placement::Disk { radius: 0.4 };
+    corridor_leftward.leader.start_x = 8.5;
+    corridor_leftward.leader.end_x = 1.5;
     vec![
+        Case {
+            name: "lanes that open ahead of a leftward sweep",
+            world: corridor_leftward,
+            global: [1, 0],
+            bands: vec![(6.5, 10.0, [1, 0]), (0.0, 5.5, [1, 0]), (3.5, 5.5, [3, 0])],
+        },
         Case {
             name: "lanes that open ahead of the swarm",
             world: corridor_ahead,

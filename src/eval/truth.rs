@@ -469,21 +469,37 @@ fn swept(
     }
     flood(&mut visited, &mut stack, lo, hi);
     let (mut c0, mut c1) = (c0_start, c1_start);
-    let (_, b_end) = world.domain(world.total_duration());
-    let (_, last) = cols(b_end, b_end);
+    let (a_end, b_end) = world.domain(world.total_duration());
     let width = b0 - a0;
-    while c1 < last {
-        c1 += 1;
-        let right = (c1 as f64 + 0.5) * h;
-        c0 = cols(right - width, right).0.max(c0);
+    // The leading edge moves one column at a time (right, or left for a leftward sweep);
+    // the new column's cells next to a visited one enter, and the flood goes on inside the
+    // domain of that moment.
+    let mut enter = |visited: &mut Vec<bool>, column: usize, from: usize, c0: usize, c1: usize| {
         for j in 0..ny {
-            let k = c1 * ny + j;
-            if reach[k] && !visited[k] && visited[k - ny] {
+            let k = column * ny + j;
+            if reach[k] && !visited[k] && visited[from * ny + j] {
                 visited[k] = true;
                 stack.push(k);
             }
         }
-        flood(&mut visited, &mut stack, c0, c1);
+        flood(visited, &mut stack, c0, c1);
+    };
+    if world.leader.end_x >= world.leader.start_x {
+        let (_, last) = cols(b_end, b_end);
+        while c1 < last {
+            c1 += 1;
+            let right = (c1 as f64 + 0.5) * h;
+            c0 = cols(right - width, right).0.max(c0);
+            enter(&mut visited, c1, c1 - 1, c0, c1);
+        }
+    } else {
+        let (first, _) = cols(a_end, a_end);
+        while c0 > first {
+            c0 -= 1;
+            let left = (c0 as f64 + 0.5) * h;
+            c1 = cols(left, left + width).1.min(c1);
+            enter(&mut visited, c0, c0 + 1, c0, c1);
+        }
     }
     visited
 }
