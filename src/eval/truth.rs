@@ -16,8 +16,8 @@
 //!   can map, so the ring with its pocket counts as one solid obstacle; likewise a lane that
 //!   opens only ahead of the swarm, and only where the domain has already passed it (the
 //!   lanes beside `worlds/corridor.ron`'s corridor, which no agent enters before x = 17 m),
-//!   is not counted. Computed on the raster by a flood fill that follows the domain's right
-//!   edge column by column (`swept`): each cell enters once. On every other bundled and
+//!   is not counted. Computed on the raster by a flood fill that follows the domain's
+//!   leading edge column by column (`swept`): each cell enters once. On every other bundled and
 //!   training world R is the whole of F's components that meet the placement, as it was
 //!   before this rule (ninth session; README, "Ground truth").
 //! - **A window's truth.** The domain of window W_i = [a, b] is the band
@@ -409,11 +409,11 @@ pub fn overlap(a: (f64, f64), b: (f64, f64)) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
-/// Indices k in `0..n` whose cell centres `(k + 0.5) h` lie in [lo, hi], or `None`.
 /// The cells of `reach` that the swarm can visit while it stays in the moving domain D(t):
 /// flood fill from the placement's cells `seeds` inside D(0) (the dispersion), then, as
-/// the domain's right edge passes each column, from that column's cells next to a visited
-/// one, over unvisited cells of `reach` inside the domain at that moment. A cell enters
+/// the domain's leading edge (its right edge, or its left one for a leftward sweep) passes
+/// each column, from that column's cells next to a visited one, over unvisited cells of
+/// `reach` inside the domain at that moment. A cell enters
 /// once, so the cost is O(cells) plus one pass over each column.
 fn swept(
     reach: &[bool],
@@ -504,6 +504,7 @@ fn swept(
     visited
 }
 
+/// Indices k in `0..n` whose cell centres `(k + 0.5) h` lie in [lo, hi], or `None`.
 fn index_range(lo: f64, hi: f64, h: f64, n: usize) -> Option<(usize, usize)> {
     // `f64::max` would turn a NaN bound into 0: reject it first.
     if lo.is_nan() || hi.is_nan() || n == 0 {
