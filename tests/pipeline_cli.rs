@@ -31,13 +31,21 @@ fn summary_without_timings(dir: &Path) -> serde_json::Value {
 fn run_writes_every_output_and_is_deterministic() {
     let tmp = tempfile::tempdir().unwrap();
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
-    for dir in [&a, &b] {
-        swarmmap()
-            .args(["run", TINY, "--quiet", "--out"])
-            .arg(dir)
-            .assert()
-            .success()
-            .stdout(contains("global (β0,β1)"));
+    // The second run maps after the simulation instead of alongside it: the same outputs.
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    for (dir, after) in [(&a, false), (&b, true)] {
+        let mut cmd = swarmmap();
+        cmd.args(["run", TINY, "--quiet", "--out"]).arg(dir);
+        if after {
+            cmd.arg("--map-after");
+        }
+        let out = cmd.assert().success().stdout(contains("global (β0,β1)"));
+        let stdout = String::from_utf8_lossy(&out.get_output().stdout).to_string();
+        assert_eq!(
+            stdout.contains("alongside the simulation"),
+            !after && cores > 1,
+            "{stdout}"
+        );
     }
     for f in [
         "encounters.csv",

@@ -30,6 +30,10 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Map after the simulation instead of alongside it on the other cores (the outputs are
+    /// the same; for timing comparisons, or to leave the other cores free).
+    #[arg(long)]
+    pub map_after: bool,
 }
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
@@ -53,7 +57,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
                 .unwrap_or_else(|| swarmmap::report::default_trajectory_interval(&world)),
         ),
         progress: Some(&report),
-        alongside: true,
+        alongside: !args.map_after,
     };
     let result = run_world(&world, &opts);
     if let Some(b) = &bar {
