@@ -231,6 +231,21 @@ fn scenario3_features_are_shared_by_consecutive_windows() {
     assert_eq!(shared, 4);
 }
 
+/// The ground truth's (β0, β1) per window and over the arena: of the space the swarm can
+/// reach (README, "Ground truth"), on a 2 cm raster.
+fn reachable_per_window(world: &World) -> (Vec<[usize; 2]>, [usize; 2]) {
+    let truth = swarmmap::eval::truth::FreeSpace::new(world, 0.02).unwrap();
+    let windows = world
+        .window_spans()
+        .into_iter()
+        .map(|span| {
+            let (x0, x1) = world.span_domain(span);
+            truth.betti_in_band(x0, x1)
+        })
+        .collect();
+    (windows, truth.global_betti())
+}
+
 #[test]
 fn the_other_worlds_have_the_topology_their_comments_state() {
     let w = load("empty");
@@ -241,29 +256,12 @@ fn the_other_worlds_have_the_topology_their_comments_state() {
     // The free space has three lanes in W1 and W2, but the swarm can walk only the
     // corridor there (README, "Ground truth"): the truth is one component per window.
     assert_eq!(per_window(&w), vec![(3, 0), (3, 0), (1, 0), (1, 0)]);
-    let truth = swarmmap::eval::truth::FreeSpace::new(&w, 0.02).unwrap();
-    let reachable: Vec<[usize; 2]> = w
-        .window_spans()
-        .into_iter()
-        .map(|span| {
-            let (x0, x1) = w.span_domain(span);
-            truth.betti_in_band(x0, x1)
-        })
-        .collect();
-    assert_eq!(reachable, vec![[1, 0]; 4]);
+    assert_eq!(reachable_per_window(&w).0, vec![[1, 0]; 4]);
     // Placed over all of D(0), the swarm starts in every lane: three components in W1, W2.
     let w = load("corridor_lanes");
-    let truth = swarmmap::eval::truth::FreeSpace::new(&w, 0.02).unwrap();
-    let reachable: Vec<[usize; 2]> = w
-        .window_spans()
-        .into_iter()
-        .map(|span| {
-            let (x0, x1) = w.span_domain(span);
-            truth.betti_in_band(x0, x1)
-        })
-        .collect();
+    let (reachable, global) = reachable_per_window(&w);
     assert_eq!(reachable, vec![[3, 0], [3, 0], [1, 0], [1, 0]]);
-    assert_eq!(truth.global_betti(), [1, 0]);
+    assert_eq!(global, [1, 0]);
     assert_eq!(betti(&load("pillars"), 0.0, 30.0), (1, 24));
     assert_eq!(betti(&load("nonconvex"), 0.0, 30.0), (1, 2));
     assert_eq!(betti(&load("touching"), 0.0, 30.0), (1, 1));
