@@ -204,14 +204,10 @@ impl FreeSpace {
             }
         }
 
-        // Components of F, then keep those meeting the placement region.
-        let (f_labels, f_count) = label_4(&free, nx, ny);
-        let mut seeded = vec![false; f_count];
+        // The free cells of the placement region; R grows from them (`swept`).
         let mut seeds: Vec<usize> = Vec::new();
         let mut mark = |i: usize, j: usize| {
-            let l = f_labels[i * ny + j];
-            if l != NONE {
-                seeded[l as usize] = true;
+            if free[i * ny + j] {
                 seeds.push(i * ny + j);
             }
         };
@@ -249,11 +245,7 @@ impl FreeSpace {
                 }
             }
         }
-        let reach: Vec<bool> = f_labels
-            .iter()
-            .map(|&l| l != NONE && seeded[l as usize])
-            .collect();
-        let reach = swept(&reach, &seeds, world, h, nx, ny);
+        let reach = swept(&free, &seeds, world, h, nx, ny);
         let (comp, components) = label_4(&reach, nx, ny);
         let holes = count_holes_8(&reach, nx, ny);
         Ok(Self {
@@ -409,7 +401,8 @@ pub fn overlap(a: (f64, f64), b: (f64, f64)) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
-/// The cells of `reach` that the swarm can visit while it stays in the moving domain D(t):
+/// The cells of the free space `reach` that the swarm can visit while it stays in the moving
+/// domain D(t):
 /// flood fill from the placement's cells `seeds` inside D(0) (the dispersion), then, as
 /// the domain's leading edge (its right edge, or its left one for a leftward sweep) passes
 /// each column, from that column's cells next to a visited one, over unvisited cells of

@@ -309,24 +309,29 @@ impl EncounterGraph {
     /// indices), as [`Self::distances_from`] gives them, stopping once every target is
     /// reached: a stitching cloud's points lie close together in a large graph.
     pub fn distances_to(&self, source: usize, targets: &[usize]) -> Vec<f64> {
-        let mut slot: HashMap<usize, Vec<usize>> = HashMap::new();
+        // The first place of each target in `targets` (a dense array: this is looked up for
+        // every encounter the run settles).
+        let mut first = vec![u32::MAX; self.encounters];
+        let mut left = 0usize;
         for (k, &t) in targets.iter().enumerate() {
-            slot.entry(t).or_default().push(k);
+            if first[t] == u32::MAX {
+                first[t] = k as u32;
+                left += 1;
+            }
         }
         let mut out = vec![f64::INFINITY; targets.len()];
-        let mut left = slot.len();
-        if left == 0 {
-            return out;
-        }
-        self.settle_from(source, |j, d| {
-            if let Some(ks) = slot.get(&j) {
-                for &k in ks {
-                    out[k] = d;
+        if left > 0 {
+            self.settle_from(source, |j, d| {
+                if first[j] != u32::MAX {
+                    out[first[j] as usize] = d;
+                    left -= 1;
                 }
-                left -= 1;
-            }
-            left > 0
-        });
+                left > 0
+            });
+        }
+        for (k, &t) in targets.iter().enumerate() {
+            out[k] = out[first[t] as usize];
+        }
         out
     }
 
