@@ -25,6 +25,13 @@ pub const RETURN_NOISE: f64 = PI / 3.0;
 /// than a full random-walk run away from the leader.
 pub const RETURN_RUN_LENGTH: f64 = 0.3;
 
+/// Seconds of random walk a returning agent takes when its patience
+/// (`swarm.return_patience`) runs out: about 6 m of walking, which carries it ≈ 2.5 m from
+/// where it was at λ = 1 m. A concave nook that opens away from the sweep (a disc touching
+/// a wall, the inner corner of an L, the near side of a wall standing on a side) traps an
+/// agent whose every return run points into it; a normal return takes seconds.
+pub const RETURN_ESCAPE: f64 = 60.0;
+
 /// Interval of the leader's track in `leader.csv`, seconds (rounded to whole steps).
 pub const LEADER_INTERVAL: f64 = 1.0;
 
@@ -103,6 +110,14 @@ struct Agent {
     normals: Vec<(P, Other)>,
     /// The wall being followed, if any (`swarm.wall_following`).
     follow: Option<Follow>,
+    /// While returning: when the agent last started following the gradient, seconds.
+    return_since: f64,
+    /// While returning: the current run is part of an escape (a random walk taken after
+    /// `swarm.return_patience` seconds outside D(t)), which lasts until `escape_until`.
+    escape: bool,
+    escape_until: f64,
+    /// Escapes taken since the agent left D(t); each lasts twice as long as the last.
+    escapes: u32,
     /// Boxed: the generator's state and block buffer (≈ 300 bytes) would otherwise make
     /// the per-step passes over all agents stream through about four times more memory.
     rng: Box<ChaCha8Rng>,
@@ -135,6 +150,10 @@ impl Agent {
             pause_until: 0.0,
             normals: Vec::new(),
             follow: None,
+            return_since: 0.0,
+            escape: false,
+            escape_until: 0.0,
+            escapes: 0,
             rng: Box::new(rng),
         }
     }
@@ -150,7 +169,7 @@ impl Agent {
     /// A fresh heading for the agent's mode: isotropic while walking, towards `leader_x`
     /// within ±[`RETURN_NOISE`] while returning; away from every contact in `normals`.
     fn new_heading(&mut self, x: f64, leader_x: f64) {
-        let returning = self.state == AgentState::Return;
+        let returning = self.state == AgentState::Return && !self.escape;
         let base = if leader_x >= x { 0.0 } else { PI };
         let draw = |rng: &mut ChaCha8Rng| {
             if returning {
@@ -188,12 +207,33 @@ impl Agent {
 
     /// Draws the length of a new run for the agent's mode, metres.
     fn new_run(&mut self, world: &World) {
-        let mean = if self.state == AgentState::Return {
+        let mean = if self.state == AgentState::Return && !self.escape {
             RETURN_RUN_LENGTH.min(world.swarm.mean_run_length)
         } else {
             world.swarm.mean_run_length
         };
         self.run_left = exponential(&mut self.rng, mean);
+    }
+
+    /// Before a returning agent's next run, at time `t`: after `swarm.return_patience`
+    /// seconds of following the gradient without regaining D(t) the agent walks for
+    /// [`RETURN_ESCAPE`] seconds as a walking agent does (isotropic headings, the walk's
+    /// run length), then follows the gradient again, with the patience counted from the
+    /// escape's end; each further escape before it regains D(t) lasts twice as long (up to
+    /// 8 times), so that a nook it keeps returning to is left in the end. Either kind of run draws the same random numbers, so a run in which
+    /// no agent escapes is unchanged. `true` when an escape starts.
+    fn next_return_run(&mut self, t: f64, patience: f64) -> bool {
+        if self.state != AgentState::Return {
+            return false;
+        }
+        let start = t >= self.escape_until && t - self.return_since >= patience;
+        if start {
+            self.escape_until = t + RETURN_ESCAPE * f64::from(1u32 << self.escapes.min(3));
+            self.escapes += 1;
+            self.return_since = self.escape_until;
+        }
+        self.escape = t < self.escape_until;
+        start
     }
 
     /// Handles the contacts of the last step (`normals`) under wall following; `false`
@@ -328,7 +368,7 @@ fn side_gaps(world: &World, p: P, r: f64) -> [(f64, P); 4] {
 
 fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
     let s = &world.swarm;
-    let positive: [(&'static str, f64); 10] = [
+    let positive: [(&'static str, f64); 11] = [
         ("simulation.dt", world.simulation.dt),
         ("swarm.detection_radius", s.detection_radius),
         ("swarm.body_radius", s.body_radius),
@@ -336,6 +376,7 @@ fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
         ("swarm.mean_stop_duration", s.mean_stop_duration),
         ("swarm.comm_radius", s.comm_radius),
         ("swarm.wall_following_length", s.wall_following_length),
+        ("swarm.return_patience", s.return_patience),
         ("leader.speed", world.leader.speed),
         ("arena.width", world.arena.width),
         ("arena.height", world.arena.height),
@@ -471,15 +512,23 @@ impl Run<'_> {
             // Returning agents follow the leader's gradient, not walls.
             a.state = AgentState::Return;
             a.follow = None;
+            a.return_since = t;
+            a.escape = false;
+            a.escape_until = t;
+            a.escapes = 0;
             a.new_heading(p.0, leader_x);
             a.new_run(world);
         } else if inside && a.state == AgentState::Return {
             a.state = AgentState::Walk;
+            a.escape = false;
         }
         if !a.normals.is_empty() {
             if !a.wall_contact(world, p) {
                 // A contact ends the run: turn away and draw a new run length.
                 a.follow = None;
+                if a.next_return_run(t, world.swarm.return_patience) {
+                    self.stats.return_escapes += 1;
+                }
                 a.new_heading(p.0, leader_x);
                 a.new_run(world);
                 self.stats.collisions += 1;
@@ -520,6 +569,9 @@ impl Run<'_> {
                 }
             }
         } else if a.run_left <= 0.0 {
+            if a.next_return_run(t, world.swarm.return_patience) {
+                self.stats.return_escapes += 1;
+            }
             a.new_heading(p.0, leader_x);
             a.new_run(world);
         }

@@ -40,7 +40,7 @@ mod params;
 mod physics;
 mod placement;
 
-pub use engine::{LEADER_INTERVAL, RETURN_NOISE, simulate};
+pub use engine::{LEADER_INTERVAL, RETURN_ESCAPE, RETURN_NOISE, simulate};
 pub use output::{
     encounters_csv, leader_csv, meta_json, static_intervals_csv, trajectories_csv, world_json,
     write_run,

@@ -114,6 +114,7 @@ pub fn world_json(world: &World) -> Value {
             "comm_radius": s.comm_radius,
             "wall_following": s.wall_following,
             "wall_following_length": s.wall_following_length,
+            "return_patience": s.return_patience,
             "placement": placement,
         },
         "leader": {
@@ -186,6 +187,7 @@ pub fn meta_json(world: &World, out: &SimOutput) -> Vec<u8> {
             "collisions": st.collisions,
             "wall_follows": st.wall_follows,
             "presses": st.presses,
+            "return_escapes": st.return_escapes,
         },
         "timings": {
             "wall_time_s": st.wall_time_s,

@@ -146,6 +146,9 @@ pub struct SimStats {
     /// there by another contact, the end of a run or a landmark's release): a turn, or
     /// under wall following the start or switch of a follow.
     pub presses: usize,
+    /// Escapes (random walks of [`RETURN_ESCAPE`](super::RETURN_ESCAPE) seconds) of
+    /// returning agents that had not regained D(t) for `swarm.return_patience` seconds.
+    pub return_escapes: usize,
     /// Wall time of the whole run, seconds (not deterministic).
     pub wall_time_s: f64,
     /// Wall time inside the Rapier step, seconds (not deterministic).

@@ -458,6 +458,12 @@ impl WorldSpec {
             "metres",
             "give a positive mean length followed along a wall, e.g. 1.0",
         )?;
+        let return_patience = ctx.positive(
+            "swarm.return_patience",
+            s.return_patience.unwrap_or(d.return_patience),
+            "seconds",
+            "give a positive patience in seconds, e.g. 300.0 (1e12 never escapes)",
+        )?;
         let placement = match s.placement.clone() {
             None => d.placement.clone(),
             Some(PlacementSpec::Window) => Placement::Window,
@@ -482,6 +488,7 @@ impl WorldSpec {
             comm_radius,
             wall_following,
             wall_following_length,
+            return_patience,
             placement,
         };
 

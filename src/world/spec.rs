@@ -69,6 +69,7 @@ pub struct SwarmSpec {
     pub comm_radius: Option<f64>,
     pub wall_following: Option<f64>,
     pub wall_following_length: Option<f64>,
+    pub return_patience: Option<f64>,
     pub placement: Option<PlacementSpec>,
 }
 
@@ -248,6 +249,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "swarm.comm_radius",
     "swarm.wall_following",
     "swarm.wall_following_length",
+    "swarm.return_patience",
     "swarm.placement",
     "leader",
     "leader.speed",
@@ -350,6 +352,7 @@ impl WorldSpec {
                             "comm_radius" => put(&mut s.comm_radius, p, v)?,
                             "wall_following" => put(&mut s.wall_following, p, v)?,
                             "wall_following_length" => put(&mut s.wall_following_length, p, v)?,
+                            "return_patience" => put(&mut s.return_patience, p, v)?,
                             "placement" => put(&mut s.placement, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }

@@ -71,6 +71,10 @@ pub struct SwarmParams {
     /// Mean length followed along a wall before the agent turns away, metres
     /// (exponentially distributed; default: `1.0`).
     pub wall_following_length: f64,
+    /// Seconds a returning agent (outside D(t)) follows the leader's gradient without
+    /// regaining D(t) before it walks at random for a while to leave a nook the gradient
+    /// keeps it in (default: `300.0`; a very large value disables the escape).
+    pub return_patience: f64,
     /// Initial placement (default: `Disk(radius: 1.0)`).
     pub placement: Placement,
 }
@@ -89,6 +93,7 @@ impl Default for SwarmParams {
             comm_radius: 1.0,
             wall_following: 0.0,
             wall_following_length: 1.0,
+            return_patience: 300.0,
             placement: Placement::Disk { radius: 1.0 },
         }
     }
