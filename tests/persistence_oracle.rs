@@ -107,6 +107,15 @@ fn xor(a: &[usize], b: &[usize]) -> Vec<usize> {
 
 /// Whether the edge set `z` is a Z/2 boundary of triangles with value ≤ `s`.
 fn is_boundary(n: usize, d: &dyn Fn(usize, usize) -> f64, z: &[(usize, usize)], s: f64) -> bool {
+    is_boundary_of(n, z, &|i, j, k| d(i, j).max(d(i, k)).max(d(j, k)) <= s)
+}
+
+/// Whether the edge set `z` is a Z/2 boundary of the triangles `keep` admits.
+fn is_boundary_of(
+    n: usize,
+    z: &[(usize, usize)],
+    keep: &dyn Fn(usize, usize, usize) -> bool,
+) -> bool {
     let eid = |i: usize, j: usize| i * n + j;
     let mut basis = std::collections::HashMap::<usize, Vec<usize>>::new(); // pivot → vector
     let reduce = |mut v: Vec<usize>, basis: &std::collections::HashMap<usize, Vec<usize>>| {
@@ -121,7 +130,7 @@ fn is_boundary(n: usize, d: &dyn Fn(usize, usize) -> f64, z: &[(usize, usize)], 
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
-                if d(i, j).max(d(i, k)).max(d(j, k)) <= s {
+                if keep(i, j, k) {
                     let mut b = vec![eid(i, j), eid(i, k), eid(j, k)];
                     b.sort();
                     let r = reduce(b, &basis);
@@ -160,6 +169,32 @@ fn compare(n: usize, d: &dyn Fn(usize, usize) -> f64, got: &Diagram, t: f64) {
                 is_boundary(n, d, z, b.death),
                 "cycle of {b:?} survives its death"
             );
+            // The death triangle: its longest edge is the death, and (where no other
+            // triangle ties with it, so the order among equal values cannot matter) the
+            // triangles before it together with it make the cycle a boundary.
+            let [x, y, w] = b
+                .death_triangle
+                .expect("a finite H1 bar has a death triangle");
+            let diam = |i: usize, j: usize, k: usize| d(i, j).max(d(i, k)).max(d(j, k));
+            assert!(x < y && y < w && w < n, "{b:?}");
+            assert_eq!(diam(x, y, w), b.death, "{b:?}");
+            let mut ties = 0;
+            for i in 0..n {
+                for j in i + 1..n {
+                    for k in j + 1..n {
+                        ties += usize::from(diam(i, j, k) == b.death);
+                    }
+                }
+            }
+            if ties == 1 {
+                assert!(
+                    is_boundary_of(n, z, &|i, j, k| diam(i, j, k) < b.death
+                        || [i, j, k] == [x, y, w]),
+                    "{b:?}: the death triangle does not kill the cycle"
+                );
+            }
+        } else {
+            assert_eq!(b.death_triangle, None);
         }
     }
 }
@@ -237,4 +272,49 @@ fn degenerate_inputs() {
     let same = PointCloud::from_rows(&[[1.0, 1.0]; 5]).unwrap();
     let d = rips_points(&same, &RipsOptions::default());
     assert_eq!(d.bars.len(), 1);
+}
+
+/// Two rings far apart: each hole's death triangle spans its own ring's void; it need not
+/// contain the centre (Rips triangles overlap in the plane), but it is not a triangle of
+/// neighbours on the ring, nor one across both rings.
+#[test]
+fn death_triangles_lie_in_their_voids() {
+    let mut rows = Vec::new();
+    let ring = |rows: &mut Vec<[f64; 2]>, cx: f64, r: f64, m: usize| {
+        for i in 0..m {
+            let a = std::f64::consts::TAU * i as f64 / m as f64;
+            // A fixed wobble of the radius, so no two triangles tie.
+            let rr = r * (1.0 + 0.03 * ((7 * i) as f64).sin());
+            rows.push([cx + rr * a.cos(), rr * a.sin()]);
+        }
+    };
+    ring(&mut rows, 0.0, 1.0, 24);
+    ring(&mut rows, 5.0, 0.6, 16);
+    let p = PointCloud::from_rows(&rows).unwrap();
+    let got = rips_points(&p, &opts(None));
+    let holes: Vec<_> = got.dim(1).filter(|b| b.death / b.birth > 2.0).collect();
+    assert_eq!(holes.len(), 2, "{:?}", got.dim(1).collect::<Vec<_>>());
+    let mut centres = Vec::new();
+    for b in holes {
+        let t = b.death_triangle.unwrap();
+        let c = t.iter().fold([0.0, 0.0], |c, &v| {
+            [c[0] + rows[v][0] / 3.0, c[1] + rows[v][1] / 3.0]
+        });
+        let (cx, r) = if t[0] < 24 { (0.0, 1.0) } else { (5.0, 0.6) };
+        assert!(
+            t.iter().all(|&v| (v < 24) == (t[0] < 24)),
+            "{t:?} spans both rings"
+        );
+        // It spans the void: its longest edge (the death) is a chord of at least a radius,
+        // against a spacing of 0.26 radii between neighbours on the ring, and its centroid
+        // is well inside the ring, where three neighbours' would sit on it.
+        assert!(b.death >= r, "{b:?}");
+        assert!(
+            (c[0] - cx).hypot(c[1]) < 0.8 * r,
+            "centroid {c:?} of {t:?} is not in the void of the ring at x = {cx}"
+        );
+        centres.push(cx);
+    }
+    centres.sort_by(f64::total_cmp);
+    assert_eq!(centres, [0.0, 5.0]);
 }

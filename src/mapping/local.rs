@@ -113,6 +113,11 @@ pub struct Hole {
     pub death: f64,
     /// Edges of the representative cycle, as pairs of indices into `events`.
     pub cycle: Vec<(usize, usize)>,
+    /// The three representatives (indices into `events`) of the triangle whose entry
+    /// kills the hole's class; its longest edge, of length `death`, spans the void itself,
+    /// which the cycle, drawn through the bar's birth edge, can pass 1–3 m from (README
+    /// "Accuracy", step 16). `null` only if the engine gave no death triangle.
+    pub void: Option<[usize; 3]>,
 }
 
 /// One real component of a window's encounter graph.
@@ -347,6 +352,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     birth: f.birth,
                     death: f.death,
                     cycle,
+                    void: bar.death_triangle.map(|t| t.map(|x| reps[x])),
                 });
             }
             bars.push(MapBar {

@@ -378,6 +378,7 @@ mod tests {
                     birth: 1.0,
                     death: 2.0,
                     cycle,
+                    void: None,
                 }],
             }],
             betti: [1, 1],

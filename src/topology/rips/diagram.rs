@@ -16,6 +16,11 @@ pub struct Bar {
     /// that carries the class (sorted). Every edge has length ≤ `birth` and one has length
     /// exactly `birth`.
     pub cycle: Option<Vec<(usize, usize)>>,
+    /// For H1 bars with a finite death: the vertices (sorted) of the triangle whose entry
+    /// kills the class; its longest edge has length exactly `death`. The cycle runs through
+    /// the birth edge, which can lie far from what keeps the class alive; this triangle
+    /// spans the void itself.
+    pub death_triangle: Option<[usize; 3]>,
 }
 
 impl Bar {
@@ -76,6 +81,7 @@ mod tests {
             birth,
             death,
             cycle: None,
+            death_triangle: None,
         }
     }
 

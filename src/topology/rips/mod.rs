@@ -90,6 +90,7 @@ fn diagram<M: Metric>(m: &M, opts: &RipsOptions) -> Diagram {
         birth,
         death,
         cycle: None,
+        death_triangle: None,
     };
     bars.extend(
         raw.tree
@@ -109,6 +110,11 @@ fn diagram<M: Metric>(m: &M, opts: &RipsOptions) -> Diagram {
             continue;
         }
         let mut b = bar(1, birth, death);
+        b.death_triangle = p.death.map(|t| {
+            let mut v = [t.a as usize, t.b as usize, t.c as usize];
+            v.sort_unstable();
+            v
+        });
         if opts.cycles {
             b.cycle = reps.remove(&p.birth).map(|c| {
                 let mut c: Vec<_> = c.iter().map(|e| (e.b as usize, e.a as usize)).collect();
