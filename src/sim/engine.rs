@@ -26,8 +26,9 @@ pub const RETURN_NOISE: f64 = PI / 3.0;
 pub const RETURN_RUN_LENGTH: f64 = 0.3;
 
 /// Seconds of random walk a returning agent takes when its patience
-/// (`swarm.return_patience`) runs out: about 6 m of walking, which carries it ≈ 2.5 m from
-/// where it was at λ = 1 m. A concave nook that opens away from the sweep (a disc touching
+/// (`swarm.return_patience`) runs out: about 6 m of walking, which carries it ≈ 3 m (root
+/// mean square, √(2 λ L) for L = 6 m at λ = 1 m, less where it meets walls) from where it
+/// was. A concave nook that opens away from the sweep (a disc touching
 /// a wall, the inner corner of an L, the near side of a wall standing on a side) traps an
 /// agent whose every return run points into it; a normal return takes seconds.
 pub const RETURN_ESCAPE: f64 = 60.0;
@@ -220,8 +221,9 @@ impl Agent {
     /// [`RETURN_ESCAPE`] seconds as a walking agent does (isotropic headings, the walk's
     /// run length), then follows the gradient again, with the patience counted from the
     /// escape's end; each further escape before it regains D(t) lasts twice as long (up to
-    /// 8 times), so that a nook it keeps returning to is left in the end. Either kind of run draws the same random numbers, so a run in which
-    /// no agent escapes is unchanged. `true` when an escape starts.
+    /// 8 times), so that a nook it keeps returning to is left in the end. Either kind of
+    /// run draws the same random numbers, so a run in which no agent escapes is unchanged.
+    /// `true` when an escape starts.
     fn next_return_run(&mut self, t: f64, patience: f64) -> bool {
         if self.state != AgentState::Return {
             return false;
