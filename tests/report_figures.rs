@@ -216,3 +216,48 @@ fn rendering_the_same_run_twice_gives_the_same_bytes() {
     let b = render(&load_run(Path::new(FIXTURE)).unwrap()).unwrap();
     assert!(a == b);
 }
+
+/// A hole's cycle is drawn in black and its void (the death triangle) as a closed red
+/// triangle, on the embedding and on the true positions.
+#[test]
+fn a_holes_void_is_drawn_as_a_closed_triangle() {
+    let mut run = load_run(Path::new(FIXTURE)).unwrap();
+    let w = &mut run.windows[0];
+    let e = w.components[0].events.clone();
+    w.components[0].holes.push(swarmmap::report::data::HoleIn {
+        birth: 1.0,
+        death: 2.0,
+        cycle: vec![(e[0], e[1]), (e[1], e[2]), (e[0], e[2])],
+        void: Some([e[3], e[4], e[5]]),
+    });
+    let report = render(&run).unwrap();
+    let svg = &report
+        .figures
+        .iter()
+        .find(|f| f.name == "window_1_cloud.svg")
+        .unwrap()
+        .svg;
+    let red: Vec<&str> = svg
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains("stroke=\"#FF0000\""))
+        .collect();
+    // One on the embedding panel, one on the true positions.
+    assert_eq!(red.len(), 2, "{red:?}");
+    for l in red {
+        let pts: Vec<&str> = l
+            .split("points=\"")
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .filter(|p| p.contains(','))
+            .collect();
+        assert_eq!(pts.len(), 4, "{l}");
+        assert_eq!(pts[0], pts[3], "not closed: {l}");
+    }
+    assert!(
+        report
+            .figures
+            .iter()
+            .any(|f| f.caption.contains("red: the triangle"))
+    );
+}

@@ -40,6 +40,9 @@ pub struct HoleIn {
     pub birth: f64,
     pub death: f64,
     pub cycle: Vec<(usize, usize)>,
+    /// The death triangle's three events (absent in maps written before it existed).
+    #[serde(default)]
+    pub void: Option<[usize; 3]>,
 }
 
 /// A real component of a window.
@@ -185,6 +188,14 @@ fn check_window(path: &Path, w: &WindowIn) -> Result<(), ReportError> {
             ));
         }
         for hole in &comp.holes {
+            if let Some(&j) = hole.void.iter().flatten().find(|&&j| j >= n) {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "a hole of component {c} has the void event {j}, but the window has {n} events"
+                    ),
+                ));
+            }
             if let Some(&(a, b)) = hole.cycle.iter().find(|&&(a, b)| a >= n || b >= n) {
                 return Err(invalid(
                     path,

@@ -583,6 +583,17 @@ fn time_colour(t: f64, (t0, t1): (f64, f64)) -> RGBColor {
     viridis(if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 })
 }
 
+/// The void triangles (closed, as event indices) of the robust holes of component `comp`
+/// of `w`, or of all its components.
+fn voids_of<'w>(w: &'w WindowIn, comp: Option<usize>) -> impl Iterator<Item = [usize; 4]> + 'w {
+    w.components
+        .iter()
+        .enumerate()
+        .filter(move |(c, _)| comp.is_none_or(|k| k == *c))
+        .flat_map(|(_, comp)| comp.holes.iter().filter_map(|h| h.void))
+        .map(|[a, b, c]| [a, b, c, a])
+}
+
 fn cycles_of<'w>(
     w: &'w WindowIn,
     comp: Option<usize>,
@@ -613,85 +624,94 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
     let truth = truth.filter(|t| !t.is_empty());
     let panels_n = w.components.len() + usize::from(truth.is_some());
     let times = (w.start, w.end);
-    let svg =
-        render(&name, panel_count(panels_n), |root| {
-            if panels_n == 0 {
-                return empty_panel(root, &format!("W{}", w.index), "no real component");
-            }
-            let panels = root.split_evenly((1, panels_n));
-            for (ci, comp) in w.components.iter().enumerate() {
-                let pts: Vec<(f64, f64)> = comp
-                    .events
-                    .iter()
-                    .map(|&j| (w.events[j].point[0], w.events[j].point[1]))
-                    .collect();
-                let mut c = chart(
-                    &panels[ci],
-                    &format!("W{} component {}: embedding", w.index, ci + 1),
-                    span(pts.iter().map(|p| p.0)),
-                    span(pts.iter().map(|p| p.1)),
-                    "MDS coordinate 1 (s)",
-                    "MDS coordinate 2 (s)",
-                )?;
-                let k = stride(pts.len());
-                c.draw_series(comp.events.iter().zip(&pts).step_by(k).map(|(&j, &p)| {
-                    Circle::new(p, 2, time_colour(w.events[j].start, times).filled())
-                }))?;
-                let at = |j: usize| (w.events[j].point[0], w.events[j].point[1]);
-                c.draw_series(
-                    cycles_of(w, Some(ci))
-                        .map(|(a, b)| PathElement::new(vec![at(a), at(b)], BLACK.stroke_width(2))),
-                )?;
-            }
-            if let Some(truth) = &truth {
-                let domain = run
-                    .summary
-                    .windows
-                    .iter()
-                    .find(|s| s.index == w.index)
-                    .and_then(|s| s.domain);
-                let x = domain.map_or_else(|| span(truth.iter().map(|p| p.0)), |d| (d[0], d[1]));
-                let y = run.world.as_ref().map_or_else(
-                    || span(truth.iter().map(|p| p.1)),
-                    |wd| (0.0, wd.arena.height),
-                );
-                let mut c = chart(
-                    &panels[panels_n - 1],
-                    &format!("W{}: the same events at their true positions", w.index),
-                    x,
-                    y,
-                    "x (m)",
-                    "y (m)",
-                )?;
-                if let Some(world) = &run.world {
-                    for o in &world.obstacles {
-                        c.draw_series(
-                            obstacle_polygons(o)
-                                .into_iter()
-                                .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
-                        )?;
-                    }
+    let svg = render(&name, panel_count(panels_n), |root| {
+        if panels_n == 0 {
+            return empty_panel(root, &format!("W{}", w.index), "no real component");
+        }
+        let panels = root.split_evenly((1, panels_n));
+        for (ci, comp) in w.components.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = comp
+                .events
+                .iter()
+                .map(|&j| (w.events[j].point[0], w.events[j].point[1]))
+                .collect();
+            let mut c = chart(
+                &panels[ci],
+                &format!("W{} component {}: embedding", w.index, ci + 1),
+                span(pts.iter().map(|p| p.0)),
+                span(pts.iter().map(|p| p.1)),
+                "MDS coordinate 1 (s)",
+                "MDS coordinate 2 (s)",
+            )?;
+            let k = stride(pts.len());
+            c.draw_series(comp.events.iter().zip(&pts).step_by(k).map(|(&j, &p)| {
+                Circle::new(p, 2, time_colour(w.events[j].start, times).filled())
+            }))?;
+            let at = |j: usize| (w.events[j].point[0], w.events[j].point[1]);
+            c.draw_series(
+                cycles_of(w, Some(ci))
+                    .map(|(a, b)| PathElement::new(vec![at(a), at(b)], BLACK.stroke_width(2))),
+            )?;
+            c.draw_series(
+                voids_of(w, Some(ci))
+                    .map(|t| PathElement::new(t.map(at).to_vec(), RED.stroke_width(2))),
+            )?;
+        }
+        if let Some(truth) = &truth {
+            let domain = run
+                .summary
+                .windows
+                .iter()
+                .find(|s| s.index == w.index)
+                .and_then(|s| s.domain);
+            let x = domain.map_or_else(|| span(truth.iter().map(|p| p.0)), |d| (d[0], d[1]));
+            let y = run.world.as_ref().map_or_else(
+                || span(truth.iter().map(|p| p.1)),
+                |wd| (0.0, wd.arena.height),
+            );
+            let mut c = chart(
+                &panels[panels_n - 1],
+                &format!("W{}: the same events at their true positions", w.index),
+                x,
+                y,
+                "x (m)",
+                "y (m)",
+            )?;
+            if let Some(world) = &run.world {
+                for o in &world.obstacles {
+                    c.draw_series(
+                        obstacle_polygons(o)
+                            .into_iter()
+                            .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
+                    )?;
                 }
-                let k = stride(truth.len());
-                c.draw_series(w.events.iter().zip(truth).step_by(k).map(|(e, &p)| {
-                    let col = if e.noise {
-                        NOISE
-                    } else {
-                        time_colour(e.start, times)
-                    };
-                    Circle::new(p, 2, col.filled())
-                }))?;
-                c.draw_series(cycles_of(w, None).map(|(a, b)| {
-                    PathElement::new(vec![truth[a], truth[b]], BLACK.stroke_width(2))
-                }))?;
             }
-            Ok(())
-        })?;
+            let k = stride(truth.len());
+            c.draw_series(w.events.iter().zip(truth).step_by(k).map(|(e, &p)| {
+                let col = if e.noise {
+                    NOISE
+                } else {
+                    time_colour(e.start, times)
+                };
+                Circle::new(p, 2, col.filled())
+            }))?;
+            c.draw_series(
+                cycles_of(w, None).map(|(a, b)| {
+                    PathElement::new(vec![truth[a], truth[b]], BLACK.stroke_width(2))
+                }),
+            )?;
+            c.draw_series(
+                voids_of(w, None)
+                    .map(|t| PathElement::new(t.map(|j| truth[j]).to_vec(), RED.stroke_width(2))),
+            )?;
+        }
+        Ok(())
+    })?;
     Ok(Figure {
         name,
         title: format!("W{}: encounter point cloud", w.index),
         caption: format!(
-            "Each event of W{} ({:.0}–{:.0} s){} coloured by its start time (viridis: dark = early, yellow = late); black: representative cycles of the robust holes.{}",
+            "Each event of W{} ({:.0}–{:.0} s){} coloured by its start time (viridis: dark = early, yellow = late); black: representative cycles of the robust holes (drawn through each bar's birth edge); red: the triangle whose entry kills each hole's class, which spans its void.{}",
             w.index,
             w.start,
             w.end,
