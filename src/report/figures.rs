@@ -226,11 +226,16 @@ fn draw_arena(c: &mut Chart<'_, '_>, world: &World, fill: RGBColor) -> DrawResul
         vec![(0.0, 0.0), (w, 0.0), (w, h), (0.0, h), (0.0, 0.0)],
         BLACK.stroke_width(2),
     )))?;
+    draw_obstacles(c, world, fill.filled())
+}
+
+/// Every obstacle of `world`, filled with `style`.
+fn draw_obstacles(c: &mut Chart<'_, '_>, world: &World, style: ShapeStyle) -> DrawResult {
     for o in &world.obstacles {
         c.draw_series(
             obstacle_polygons(o)
                 .into_iter()
-                .map(|p| Polygon::new(p, fill.filled())),
+                .map(|p| Polygon::new(p, style)),
         )?;
     }
     Ok(())
@@ -678,13 +683,7 @@ pub fn cloud(run: &RunData, w: &WindowIn) -> Result<Figure, ReportError> {
                 "y (m)",
             )?;
             if let Some(world) = &run.world {
-                for o in &world.obstacles {
-                    c.draw_series(
-                        obstacle_polygons(o)
-                            .into_iter()
-                            .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
-                    )?;
-                }
+                draw_obstacles(&mut c, world, OBSTACLE.mix(0.35).filled())?;
             }
             let k = stride(truth.len());
             c.draw_series(w.events.iter().zip(truth).step_by(k).map(|(e, &p)| {
@@ -783,13 +782,7 @@ pub fn pair_cloud(run: &RunData, conn: &ConnectionIn) -> Result<Figure, ReportEr
                 "y (m)",
             )?;
             if let Some(world) = &run.world {
-                for o in &world.obstacles {
-                    c.draw_series(
-                        obstacle_polygons(o)
-                            .into_iter()
-                            .map(|p| Polygon::new(p, OBSTACLE.mix(0.35).filled())),
-                    )?;
-                }
+                draw_obstacles(&mut c, world, OBSTACLE.mix(0.35).filled())?;
             }
             c.draw_series(
                 conn.points
