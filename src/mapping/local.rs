@@ -245,7 +245,12 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
     let mut components = Vec::new();
     let mut rows_out = Vec::new();
     let mut explained = Vec::new();
-    for members in groups.into_iter().filter(|g| g.len() >= min_size.max(3)) {
+    let groups: Vec<Vec<usize>> = groups
+        .into_iter()
+        .filter(|g| g.len() >= min_size.max(3))
+        .collect();
+    let mapped: usize = groups.iter().map(Vec::len).sum();
+    for members in groups {
         // A component with too few encounters with landmarks (a log without landmark
         // intervals, or a region no landmark reached) is embedded from all its encounters,
         // as the paper's method does: dropping it would lose a real component.
@@ -302,8 +307,9 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         let (diagram, reps, vertex_metric) = match (&p.embedding_rips, p.witness) {
             (Some(er), _) => {
                 let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
+                let er = er.for_share(members.len() as f64 / mapped as f64);
                 let (diagram, picks) =
-                    super::dense::dense_rips(&coords, er, &opts).expect("finite embedding");
+                    super::dense::dense_rips(&coords, &er, &opts).expect("finite embedding");
                 let picked = picks.iter().map(|&k| coords[k]).collect();
                 let metric = VertexMetric::Coords(picked, er.dims.clamp(2, 3));
                 (diagram, picks.iter().map(|&k| members[k]).collect(), metric)
@@ -439,5 +445,65 @@ mod tests {
                 .all(|&j| !map.noise[j] && map.points[j].iter().all(|x| x.is_finite()))
         );
         assert!(c.events.iter().any(|&j| map.points[j] != [0.0; 3]));
+    }
+
+    /// Two regions that no agent joins are two components, and each gets planar Rips
+    /// points in proportion to its share of the window's encounters
+    /// ([`super::super::dense::DenseParams::for_share`]): a component is sampled at the
+    /// density of a one-component window, not at twice it because it is half the window.
+    #[test]
+    fn components_share_the_points_by_their_encounters() {
+        let big = synthetic_log(&SyntheticParams::default(), 6000);
+        let small = synthetic_log(
+            &SyntheticParams {
+                seed: 2,
+                ..SyntheticParams::default()
+            },
+            3000,
+        );
+        let offset = 1000;
+        let mut log = big.clone();
+        log.encounters
+            .extend(small.encounters.iter().cloned().map(|mut e| {
+                e.a += offset;
+                e.b += offset;
+                e
+            }));
+        log.static_intervals
+            .extend(small.static_intervals.iter().cloned().map(|mut s| {
+                s.agent += offset;
+                s
+            }));
+        log.encounters.sort_by(|x, y| {
+            x.start
+                .total_cmp(&y.start)
+                .then(x.a.cmp(&y.a))
+                .then(x.b.cmp(&y.b))
+        });
+        log.static_intervals
+            .sort_by(|x, y| x.agent.cmp(&y.agent).then(x.start.total_cmp(&y.start)));
+        let span = log.span().unwrap();
+        let window = Window {
+            index: 1,
+            start: span.0,
+            end: span.1,
+        };
+        let params = LocalParams::from_mapping(&MappingParams {
+            method: MappingMethod::Embedded,
+            ..MappingParams::default()
+        });
+        let map = local_map(&log, &window, &params);
+        assert_eq!(map.components.len(), 2);
+        let mapped: usize = map.components.iter().map(|c| c.events.len()).sum();
+        for c in &map.components {
+            let share = c.events.len() as f64 / mapped as f64;
+            let expected = (super::super::dense::EMBEDDED_POINTS as f64 * share).round();
+            assert_eq!(
+                c.representatives.len() as f64,
+                expected,
+                "{} of {mapped} events",
+                c.events.len()
+            );
+        }
     }
 }

@@ -104,6 +104,7 @@ pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
 /// Per real component of `map`, the features of the `Embedded` topology stage run on the
 /// true positions `truth` (one per event of `map`) of its events; see [`Fidelity::oracle`].
 pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::classify::Feature>> {
+    let mapped: usize = map.components.iter().map(|c| c.events.len()).sum();
     map.components
         .iter()
         .filter_map(|c| {
@@ -114,7 +115,8 @@ pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::cla
                 .collect();
             let (diagram, _) = super::dense::dense_rips(
                 &coords,
-                &super::dense::DenseParams::embedded(),
+                &super::dense::DenseParams::embedded()
+                    .for_share(c.events.len() as f64 / mapped as f64),
                 &RipsOptions::default(),
             )?;
             Some(super::classify::features(&diagram))
