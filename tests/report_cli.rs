@@ -158,6 +158,23 @@ fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
         .code(2)
         .stderr(contains("window_1.json"));
 
+    // A hole void that points past the window's events.
+    let (_t6, d6) = fixture_copy();
+    let path = d6.join("maps/window_1.json");
+    let mut w: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    w["components"][0]["holes"] = serde_json::json!([
+        {"birth": 1.0, "death": 2.0, "cycle": [[0, 1]], "void": [0, 1, 99999]}
+    ]);
+    fs::write(&path, serde_json::to_string(&w).unwrap()).unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&d6)
+        .assert()
+        .code(2)
+        .stderr(contains("window_1.json").and(contains("void event 99999")));
+    assert!(!d6.join("report").exists());
+
     let (_t5, d5) = fixture_copy();
     fs::write(
         d5.join("trajectories.csv"),

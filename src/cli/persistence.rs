@@ -4,7 +4,10 @@
 //! symmetric matrix with a zero diagonal. Output on stdout: a header and one row per bar,
 //! `dim,birth,death` (`inf` for an essential class), sorted by `(dim, birth, death)`. With
 //! `--cycles` a fourth column `cycle` holds, for H1 bars, the edges of a representative
-//! cycle as `i-j;k-l;…` (0-based row numbers of the input, `i < j`), empty for H0 bars.
+//! cycle as `i-j;k-l;…` (0-based row numbers of the input, `i < j`), empty for H0 bars, and
+//! a fifth column `void` the three vertices `i;j;k` (`i < j < k`) of the triangle whose
+//! entry kills the class (its longest edge has length `death`; it spans the void itself,
+//! README "Accuracy", step 16), empty for H0 bars and essential classes.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -31,7 +34,8 @@ pub struct PersistenceArgs {
     /// which gives the same diagram as no threshold).
     #[arg(long, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
-    /// Add a `cycle` column with a representative cycle of every H1 bar.
+    /// Add a `cycle` column with a representative cycle of every H1 bar, and a `void`
+    /// column with the triangle that kills it.
     #[arg(long)]
     pub cycles: bool,
     /// Worker threads; 0 uses all cores.
@@ -135,13 +139,21 @@ fn located(file: &Path, rows: &[Row], e: MatrixError) -> anyhow::Error {
 
 /// Writes the diagram as CSV (see the module docs).
 pub fn write_diagram(w: &mut dyn Write, d: &Diagram, cycles: bool) -> std::io::Result<()> {
-    writeln!(w, "dim,birth,death{}", if cycles { ",cycle" } else { "" })?;
+    writeln!(
+        w,
+        "dim,birth,death{}",
+        if cycles { ",cycle,void" } else { "" }
+    )?;
     for b in &d.bars {
         write!(w, "{},{},{}", b.dim, b.birth, b.death)?;
         if cycles {
             let c = b.cycle.as_deref().unwrap_or(&[]);
             let s: Vec<String> = c.iter().map(|(i, j)| format!("{i}-{j}")).collect();
-            write!(w, ",{}", s.join(";"))?;
+            let void = b
+                .death_triangle
+                .map(|[i, j, k]| format!("{i};{j};{k}"))
+                .unwrap_or_default();
+            write!(w, ",{},{void}", s.join(";"))?;
         }
         writeln!(w)?;
     }
