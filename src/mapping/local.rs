@@ -409,13 +409,8 @@ mod tests {
     use crate::mapping::synthetic::{SyntheticParams, synthetic_log};
     use crate::world::{MappingMethod, MappingParams};
 
-    /// The `Embedded` method anchors its cloud on encounters with landmarks. A log without
-    /// landmark intervals (a real experiment that logged none) must still map every region
-    /// of the window as a component, embedded from all its encounters, not lose it: before
-    /// the fallback, every window of such a log came out with β0 = 0.
-    #[test]
-    fn a_log_without_landmarks_keeps_its_components() {
-        let log = synthetic_log(&SyntheticParams::default(), 3000);
+    /// One window over the whole log, and the `Embedded` method's parameters.
+    fn whole_log_embedded(log: &EncounterLog) -> (Window, LocalParams) {
         let span = log.span().unwrap();
         let window = Window {
             index: 1,
@@ -426,6 +421,17 @@ mod tests {
             method: MappingMethod::Embedded,
             ..MappingParams::default()
         });
+        (window, params)
+    }
+
+    /// The `Embedded` method anchors its cloud on encounters with landmarks. A log without
+    /// landmark intervals (a real experiment that logged none) must still map every region
+    /// of the window as a component, embedded from all its encounters, not lose it: before
+    /// the fallback, every window of such a log came out with β0 = 0.
+    #[test]
+    fn a_log_without_landmarks_keeps_its_components() {
+        let log = synthetic_log(&SyntheticParams::default(), 3000);
+        let (window, params) = whole_log_embedded(&log);
         let anchored = local_map(&log, &window, &params);
         assert_eq!(anchored.components.len(), 1);
         assert_eq!(anchored.betti[0], 1);
@@ -482,16 +488,7 @@ mod tests {
         });
         log.static_intervals
             .sort_by(|x, y| x.agent.cmp(&y.agent).then(x.start.total_cmp(&y.start)));
-        let span = log.span().unwrap();
-        let window = Window {
-            index: 1,
-            start: span.0,
-            end: span.1,
-        };
-        let params = LocalParams::from_mapping(&MappingParams {
-            method: MappingMethod::Embedded,
-            ..MappingParams::default()
-        });
+        let (window, params) = whole_log_embedded(&log);
         let map = local_map(&log, &window, &params);
         assert_eq!(map.components.len(), 2);
         let mapped: usize = map.components.iter().map(|c| c.events.len()).sum();
