@@ -11,7 +11,9 @@
 //!    Vietoris–Rips persistence (H0, H1) and, by landmark MDS, a 3-D embedding of every
 //!    encounter of the component (the encounter point cloud); the `Embedded` method then
 //!    moves the encounters of moving agents between the landmarks they lead to
-//!    ([`super::bridge`]) and computes persistence on that cloud;
+//!    ([`super::bridge`]) and computes persistence on that cloud, each component on its
+//!    share of the window's planar Rips points
+//!    ([`super::dense::DenseParams::for_share`]), so that all are sampled alike;
 //! 4. the classifier ([`super::classify`]) keeps the robust classes; (β0, β1) sum over
 //!    components.
 //!
