@@ -230,7 +230,7 @@ impl EncounterGraph {
 
     /// Shortest-path distances (seconds) from encounter `source` to every encounter
     /// (`f64::INFINITY` where unreachable). Dijkstra with a monotone radix heap
-    /// ([`RadixHeap`]): O(E + V · 64) rather than a binary heap's O((V + E) log V), and
+    /// (`RadixHeap`): O(E + V · 64) rather than a binary heap's O((V + E) log V), and
     /// cache-friendly, which keeps the cost per encounter flat as windows grow. The result
     /// does not depend on the order in which equal keys pop (each distance is the minimum
     /// over its neighbours' final distances), so it is deterministic.

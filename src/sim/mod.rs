@@ -18,10 +18,10 @@
 //! number of landmarks is held at round(`landmark_fraction` × agents inside D(t)): landmarks
 //! that fall out of D(t) resume walking, surplus landmarks (newest first) are released, and
 //! missing ones are chosen by MaxMin on the hop distance of the communication graph
-//! ([`landmarks`]). The leader then sweeps from `start_x` to `end_x` at `leader.speed`; the
+//! (`landmarks.rs`). The leader then sweeps from `start_x` to `end_x` at `leader.speed`; the
 //! run ends when it arrives.
 //!
-//! **Encounters** come from Rapier's sensor events ([`physics`]); an encounter starts at
+//! **Encounters** come from Rapier's sensor events (`physics.rs`); an encounter starts at
 //! the first step time at which the centres are within r_d and ends at the first step time
 //! at which they are not (or at the final time). Times are multiples of `simulation.dt`.
 //!
