@@ -55,7 +55,7 @@ impl DenseParams {
     /// more than `m`. Every component is then sampled at the density of a one-component
     /// window, so that the classifier's scale-free thresholds mean the same thing in both.
     /// With `m` points in each of the two strips beside scenario 2's bar, a strip was
-    /// sampled twice as densely as a whole window (σ 0.78–0.82 against 0.94–1.44), and the
+    /// sampled twice as densely as a whole window (σ 0.77–0.92 against 0.89–1.52, scenario 2 seeds 6, 7, 12), and the
     /// estimate's ≈ 0.6 m cells stood out as holes (README "Accuracy", step 17).
     pub fn for_share(&self, share: f64) -> Self {
         let scaled = if share.is_finite() && share > 0.0 {
@@ -316,7 +316,7 @@ mod tests {
         assert_eq!(p.for_share(0.5).m, EMBEDDED_POINTS / 2);
         assert_eq!(p.for_share(0.25).m, EMBEDDED_POINTS / 4);
         assert_eq!(p.for_share(0.001).m, MIN_COMPONENT_POINTS);
-        // Never more than m, and a share that is not one keeps m.
+        // Never more than m, and a share that is not positive and finite keeps m.
         assert_eq!(p.for_share(3.0).m, EMBEDDED_POINTS);
         assert_eq!(p.for_share(f64::NAN).m, EMBEDDED_POINTS);
         assert_eq!(p.for_share(0.0).m, EMBEDDED_POINTS);

@@ -24,8 +24,8 @@ pub struct Fidelity {
     pub procrustes: Option<f64>,
     /// (β0, β1) that the topology stage finds on the events' *true* positions: each real
     /// component's events at their true positions, then the `Embedded` method's topology
-    /// stage (MaxMin of [`crate::mapping::dense::EMBEDDED_POINTS`] points, planar
-    /// Vietoris–Rips) judged by the shipped `Oracle` model. It separates the two sources of
+    /// stage (MaxMin of [`crate::mapping::dense::EMBEDDED_POINTS`] points shared among the
+    /// components by their encounters, planar Vietoris–Rips) judged by the shipped `Oracle` model. It separates the two sources of
     /// error: a window whose `oracle` is right but whose `betti` is wrong lost its features
     /// in the metric; one whose `oracle` is wrong too lost them in the sampling or the
     /// classification.
