@@ -48,17 +48,28 @@ fn square_with_cycles_and_maxdim0() {
     let last = text.lines().last().unwrap();
     let (bar, void) = last.rsplit_once(',').unwrap();
     assert_eq!(bar, "1,1,1.4142135623730951,0-1;0-3;1-2;2-3");
-    // The square's class dies when a triangle with a diagonal enters: any three of its four
-    // corners contain one (0-2 or 1-3), whose length is the death.
     let v: Vec<usize> = void.split(';').map(|x| x.parse().unwrap()).collect();
     assert_eq!(v.len(), 3);
     assert!(v.windows(2).all(|w| w[0] < w[1]) && v[2] <= 3, "{void}");
-    assert!(
-        (v.contains(&0) && v.contains(&2)) || (v.contains(&1) && v.contains(&3)),
-        "{void}"
-    );
     // Essential H0 classes have no void either.
     assert!(text.contains("\n0,0,inf,,\n"));
+    // A quadrilateral whose shorter diagonal, 1-3 (√2), kills the class born at its longest
+    // side (2-3): both triangles it closes contain 1 and 3; the other diagonal (0-2) is longer.
+    let q = temp_csv("0,0\n1,0\n1.2,1.1\n0,1\n");
+    let out = cmd()
+        .args(["persistence", q.path().to_str().unwrap(), "--cycles"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let text = String::from_utf8(out).unwrap();
+    let last = text.lines().last().unwrap();
+    assert!(last.starts_with("1,"), "{text}");
+    let fields: Vec<&str> = last.split(',').collect();
+    assert!((fields[2].parse::<f64>().unwrap() - 2f64.sqrt()).abs() < 1e-12);
+    let v: Vec<usize> = fields[4].split(';').map(|x| x.parse().unwrap()).collect();
+    assert!(v == [0, 1, 3] || v == [1, 2, 3], "{last}");
     cmd()
         .args(["persistence", f.path().to_str().unwrap(), "--maxdim", "0"])
         .assert()
