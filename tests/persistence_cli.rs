@@ -15,6 +15,18 @@ fn cmd() -> Command {
     Command::cargo_bin("swarmmap").unwrap()
 }
 
+/// Runs `swarmmap` with `args`, asserts success and returns its stdout.
+fn stdout_of(args: &[&str]) -> String {
+    let out = cmd()
+        .args(args)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    String::from_utf8(out).unwrap()
+}
+
 fn temp_csv(text: &str) -> tempfile::NamedTempFile {
     let mut f = tempfile::Builder::new().suffix(".csv").tempfile().unwrap();
     f.write_all(text.as_bytes()).unwrap();
@@ -34,17 +46,11 @@ fn square_points() {
 #[test]
 fn square_with_cycles_and_maxdim0() {
     let f = temp_csv("0,0\n1,0\n1,1\n0,1\n");
-    let out = cmd()
-        .args(["persistence", f.path().to_str().unwrap(), "--cycles"])
-        .assert()
-        .success()
-        .stdout(predicate::str::starts_with(
-            "dim,birth,death,cycle,void\n0,0,1,,\n",
-        ))
-        .get_output()
-        .stdout
-        .clone();
-    let text = String::from_utf8(out).unwrap();
+    let text = stdout_of(&["persistence", f.path().to_str().unwrap(), "--cycles"]);
+    assert!(
+        text.starts_with("dim,birth,death,cycle,void\n0,0,1,,\n"),
+        "{text}"
+    );
     let last = text.lines().last().unwrap();
     let (bar, void) = last.rsplit_once(',').unwrap();
     assert_eq!(bar, "1,1,1.4142135623730951,0-1;0-3;1-2;2-3");
@@ -56,14 +62,7 @@ fn square_with_cycles_and_maxdim0() {
     // A quadrilateral whose shorter diagonal, 1-3 (√2), kills the class born at its longest
     // side (2-3): both triangles it closes contain 1 and 3; the other diagonal (0-2) is longer.
     let q = temp_csv("0,0\n1,0\n1.2,1.1\n0,1\n");
-    let out = cmd()
-        .args(["persistence", q.path().to_str().unwrap(), "--cycles"])
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let text = String::from_utf8(out).unwrap();
+    let text = stdout_of(&["persistence", q.path().to_str().unwrap(), "--cycles"]);
     let last = text.lines().last().unwrap();
     assert!(last.starts_with("1,"), "{text}");
     let fields: Vec<&str> = last.split(',').collect();
@@ -79,18 +78,11 @@ fn square_with_cycles_and_maxdim0() {
 
 #[test]
 fn distance_matrix_and_threshold() {
-    let out = cmd()
-        .args([
-            "persistence",
-            &fixture("graph_metric_150.dist.csv"),
-            "--distance-matrix",
-        ])
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let text = String::from_utf8(out).unwrap();
+    let text = stdout_of(&[
+        "persistence",
+        &fixture("graph_metric_150.dist.csv"),
+        "--distance-matrix",
+    ]);
     assert_eq!(text.lines().filter(|l| l.starts_with("0,")).count(), 150);
     let f = temp_csv("0,1,3\n1,0,1\n3,1,0\n");
     cmd()
