@@ -101,10 +101,57 @@ impl Columns {
     }
 }
 
+/// A reader that records where every line of its input begins, so that a byte offset
+/// names its line whatever the line endings. The `csv` crate counts a line only at a
+/// `\n`, and only after it has recorded the next record's position: every line of a
+/// `\r\n` file was reported one early and every line of a `\r` file as line 1
+/// (BurntSushi/rust-csv#395). Here `\n`, `\r\n` and a lone `\r` each end one line.
+struct LineIndex<R> {
+    inner: R,
+    /// Byte offset of the first byte of every line terminator seen so far (a `\r\n` is
+    /// recorded at its `\r`), in increasing order.
+    ends: Vec<u64>,
+    /// Bytes read so far.
+    offset: u64,
+    /// Whether the last byte read was a `\r`.
+    after_cr: bool,
+}
+
+impl<R> LineIndex<R> {
+    fn new(inner: R) -> Self {
+        Self {
+            inner,
+            ends: Vec::new(),
+            offset: 0,
+            after_cr: false,
+        }
+    }
+
+    /// The 1-based line holding byte `offset` (of the bytes already read).
+    fn line_of(&self, offset: u64) -> u64 {
+        self.ends.partition_point(|&e| e < offset) as u64 + 1
+    }
+}
+
+impl<R: std::io::Read> std::io::Read for LineIndex<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for (i, &b) in buf[..n].iter().enumerate() {
+            let at = self.offset + i as u64;
+            if b == b'\r' || (b == b'\n' && !self.after_cr) {
+                self.ends.push(at);
+            }
+            self.after_cr = b == b'\r';
+        }
+        self.offset += n as u64;
+        Ok(n)
+    }
+}
+
 /// A CSV reader that reports every problem with its file and line.
 struct CsvFile {
     path: PathBuf,
-    reader: csv::Reader<std::fs::File>,
+    reader: csv::Reader<LineIndex<std::fs::File>>,
     columns: Columns,
 }
 
@@ -116,11 +163,11 @@ impl CsvFile {
         })?;
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
-            .from_reader(file);
-        let headers = reader
-            .headers()
-            .map_err(|e| csv_error(path, 1, &e))?
-            .clone();
+            .from_reader(LineIndex::new(file));
+        let headers = match reader.headers() {
+            Ok(h) => h.clone(),
+            Err(e) => return Err(csv_error(path, reader.get_ref(), 0, &e)),
+        };
         let index: HashMap<String, usize> = headers
             .iter()
             .enumerate()
@@ -153,11 +200,12 @@ impl CsvFile {
     ) -> Result<(), LogError> {
         let mut record = csv::StringRecord::new();
         loop {
-            let line = self.reader.position().line();
+            let byte = self.reader.position().byte();
             match self.reader.read_record(&mut record) {
                 Ok(false) => return Ok(()),
                 Ok(true) => {
-                    let line = record.position().map(|p| p.line()).unwrap_or(line);
+                    let byte = record.position().map_or(byte, |p| p.byte());
+                    let line = self.reader.get_ref().line_of(byte);
                     let row = Row {
                         record: &record,
                         columns: &self.columns,
@@ -168,14 +216,15 @@ impl CsvFile {
                         message,
                     })?;
                 }
-                Err(e) => return Err(csv_error(&self.path, line, &e)),
+                Err(e) => return Err(csv_error(&self.path, self.reader.get_ref(), byte, &e)),
             }
         }
     }
 }
 
-fn csv_error(path: &Path, line: u64, e: &csv::Error) -> LogError {
-    let line = e.position().map(|p| p.line()).unwrap_or(line);
+/// The error of a CSV problem at byte `byte` (or at the position the error carries).
+fn csv_error<R>(path: &Path, lines: &LineIndex<R>, byte: u64, e: &csv::Error) -> LogError {
+    let line = lines.line_of(e.position().map_or(byte, |p| p.byte()));
     let message = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..

@@ -40,9 +40,13 @@ impl FreeSpaceRaster {
             .min(h / 8.0)
             .min(world.leader.window / 4.0)
             .max((w * h / MAX_CELLS).sqrt());
-        // Positive, bounded counts: the casts are exact.
-        let nx = ((w / cell).ceil() as usize).max(1);
-        let ny = ((h / cell).ceil() as usize).max(1);
+        // Square cells bound nx · ny only when the arena is no more elongated than the cell
+        // count: a 30 m × 10⁹ m arena would get 11.5 million, and one of 10⁻²⁰⁰ m × 30 m a
+        // count no `usize` holds. The casts saturate; the clamps keep nx · ny ≤ MAX_CELLS
+        // (cells then stretch along the long side).
+        let max_cells = MAX_CELLS as usize;
+        let nx = ((w / cell).ceil() as usize).clamp(1, max_cells);
+        let ny = ((h / cell).ceil() as usize).clamp(1, max_cells / nx);
         let (cx, cy) = (w / nx as f64, h / ny as f64);
         let mut free = Vec::with_capacity(nx * ny);
         for ix in 0..nx {
@@ -176,6 +180,25 @@ impl FreeSpaceRaster {
 mod tests {
     use super::*;
     use crate::world::Obstacle;
+
+    #[test]
+    fn elongated_arenas_stay_within_the_cell_budget() {
+        // Both shapes overflowed or exceeded the budget before the counts were clamped.
+        for (w, h) in [(30.0, 1e9), (30.0, 1e300), (1e300, 30.0), (30.0, 1e-200)] {
+            let mut world = World::empty("t", w, h);
+            world.leader.window = w;
+            let r = FreeSpaceRaster::new(&world, 0.0);
+            assert!(
+                r.nx * r.ny <= MAX_CELLS as usize,
+                "{w} × {h}: {} × {}",
+                r.nx,
+                r.ny
+            );
+            assert!(r.nx >= 1 && r.ny >= 1);
+            assert!((r.cx * r.nx as f64 - w).abs() <= 1e-9 * w);
+            assert!((r.cy * r.ny as f64 - h).abs() <= 1e-9 * h);
+        }
+    }
 
     #[test]
     fn free_area_of_empty_arena_is_the_shrunk_rectangle() {

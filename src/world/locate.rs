@@ -52,6 +52,15 @@ struct Token<'a> {
     col: usize,
 }
 
+/// If `rest` opens a raw string (`r"`, `r#"`, `r##"` …), the number of its `#`.
+fn raw_string_hashes(rest: &[(usize, char)]) -> Option<usize> {
+    if rest.first()?.1 != 'r' {
+        return None;
+    }
+    let hashes = rest[1..].iter().take_while(|x| x.1 == '#').count();
+    (rest.get(1 + hashes)?.1 == '"').then_some(hashes)
+}
+
 fn tokenize(text: &str) -> Vec<Token<'_>> {
     let chars: Vec<(usize, char)> = text.char_indices().collect();
     let mut out = Vec::new();
@@ -104,6 +113,30 @@ fn tokenize(text: &str) -> Vec<Token<'_>> {
                 }
             }
             if i < chars.len() {
+                step(&mut i, &mut line, &mut col);
+            }
+            let end = chars.get(i).map_or(text.len(), |x| x.0);
+            out.push(Token {
+                kind: Kind::Other,
+                text: &text[start..end],
+                line: sl,
+                col: sc,
+            });
+        } else if let Some(hashes) = raw_string_hashes(&chars[i..]) {
+            // A raw string, r"…" or r#"…"#: no escapes, and it ends only at a quote
+            // followed by as many `#` as opened it.
+            for _ in 0..hashes + 2 {
+                step(&mut i, &mut line, &mut col);
+            }
+            while i < chars.len() {
+                let closes = chars[i].1 == '"'
+                    && (1..=hashes).all(|k| chars.get(i + k).is_some_and(|x| x.1 == '#'));
+                if closes {
+                    for _ in 0..hashes + 1 {
+                        step(&mut i, &mut line, &mut col);
+                    }
+                    break;
+                }
                 step(&mut i, &mut line, &mut col);
             }
             let end = chars.get(i).map_or(text.len(), |x| x.0);
@@ -276,6 +309,18 @@ mod tests {
         assert_eq!(locate(TEXT, "leader.window"), None);
         assert_eq!(locate("", "name"), None);
         assert_eq!(locate("(((", "a.b"), None);
+    }
+
+    #[test]
+    fn raw_strings_hide_what_they_hold() {
+        let t = "(\n  name: r#\"x \" arena: (width: -1.0) \"#,\n  arena: (width: -2.0),\n)\n";
+        assert_eq!(locate(t, "arena.width"), Some((3, 11)));
+        let t = "(name: r\"a: (b: 1)\", a: (b: 2))";
+        assert_eq!(locate(t, "a.b"), Some((1, 26)));
+        // Unterminated: the rest of the text is the string; nothing after it is found.
+        assert_eq!(locate("(name: r##\"x\"# a: 1)", "a"), None);
+        // Identifiers that begin with r are words, not raw strings.
+        assert_eq!(locate("(radius: 1, r: 2)", "r"), Some((1, 13)));
     }
 
     #[test]
