@@ -876,27 +876,17 @@ proptest! {
         assert_matches_oracle(&t, 0)?;
     }
 
-    #[test]
-    fn mutated_encounters_are_read_whole_or_rejected_at_the_line(
-        t in valid_table(LogFile::Encounters, ALL_EOLS),
-        m in mutation(),
-    ) {
-        let (t, line) = apply(&t, &m);
-        assert_matches_oracle(&t, line)?;
-    }
+}
 
-    #[test]
-    fn mutated_static_intervals_are_read_whole_or_rejected_at_the_line(
-        t in valid_table(LogFile::Static, ALL_EOLS),
-        m in mutation(),
-    ) {
-        let (t, line) = apply(&t, &m);
-        assert_matches_oracle(&t, line)?;
-    }
+proptest! {
+    // Three files share this property: as many cases as three properties would run.
+    #![proptest_config(ProptestConfig::with_cases(3 * CASES))]
 
+    /// One mutation of a valid log of each file: read whole if the rules accept it,
+    /// otherwise rejected at the mutated line.
     #[test]
-    fn mutated_leader_tracks_are_read_whole_or_rejected_at_the_line(
-        t in valid_table(LogFile::Leader, ALL_EOLS),
+    fn mutated_logs_are_read_whole_or_rejected_at_the_line(
+        t in log_file().prop_flat_map(|f| valid_table(f, ALL_EOLS)),
         m in mutation(),
     ) {
         let (t, line) = apply(&t, &m);
@@ -1469,6 +1459,12 @@ fn free_space_raster_is_bounded_for_an_elongated_arena() {
     );
 }
 
+/// The error of reading an `encounters.csv` of `text` (which must be invalid).
+fn encounters_error(text: &str) -> String {
+    let (_dir, got) = read_log(&[(ENCOUNTERS_CSV, text.as_bytes())]);
+    got.unwrap_err().to_string()
+}
+
 /// Regression (found by the `mutated_*` properties, shrunk to `start,end,a,b\r\n,0.01,0,1`,
 /// reported at line 1): csv-core counts a line when it consumes a `\n`, which with CRLF
 /// happens only after it has taken the next record's position, so every error in a
@@ -1477,15 +1473,13 @@ fn free_space_raster_is_bounded_for_an_elongated_arena() {
 #[test]
 fn crlf_line_endings_report_the_right_line() {
     let text = "start,end,a,b\r\n0,1,0,1\r\n0,x,0,1\r\n";
-    let (_dir, got) = read_log(&[(ENCOUNTERS_CSV, text.as_bytes())]);
-    let err = got.unwrap_err().to_string();
+    let err = encounters_error(text);
     assert!(
         err.ends_with("encounters.csv:3: column `end` is `x`, which is not a number"),
         "{err}"
     );
     let text = "start,end,a,b\r\n0,1,0,1\r\n0,1,0\r\n";
-    let (_dir, got) = read_log(&[(ENCOUNTERS_CSV, text.as_bytes())]);
-    let err = got.unwrap_err().to_string();
+    let err = encounters_error(text);
     assert!(
         err.contains("encounters.csv:3: this row has 3 fields"),
         "{err}"
@@ -1497,8 +1491,7 @@ fn crlf_line_endings_report_the_right_line() {
 #[test]
 fn cr_only_line_endings_report_the_right_line() {
     let text = "start,end,a,b\r0,1,0,1\r0,x,0,1\r";
-    let (_dir, got) = read_log(&[(ENCOUNTERS_CSV, text.as_bytes())]);
-    let err = got.unwrap_err().to_string();
+    let err = encounters_error(text);
     assert!(
         err.ends_with("encounters.csv:3: column `end` is `x`, which is not a number"),
         "{err}"

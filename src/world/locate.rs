@@ -102,42 +102,37 @@ fn tokenize(text: &str) -> Vec<Token<'_>> {
                 }
                 step(&mut i, &mut line, &mut col);
             }
-        } else if c == '"' || c == '\'' {
-            step(&mut i, &mut line, &mut col);
-            while i < chars.len() && chars[i].1 != c {
-                if chars[i].1 == '\\' {
+        } else if c == '"' || c == '\'' || raw_string_hashes(&chars[i..]).is_some() {
+            if let Some(hashes) = raw_string_hashes(&chars[i..]) {
+                // A raw string, r"…" or r#"…"#: no escapes, and it ends only at a quote
+                // followed by as many `#` as opened it.
+                for _ in 0..hashes + 2 {
                     step(&mut i, &mut line, &mut col);
+                }
+                while i < chars.len() {
+                    let closes = chars[i].1 == '"'
+                        && (1..=hashes).all(|k| chars.get(i + k).is_some_and(|x| x.1 == '#'));
+                    if closes {
+                        for _ in 0..hashes + 1 {
+                            step(&mut i, &mut line, &mut col);
+                        }
+                        break;
+                    }
+                    step(&mut i, &mut line, &mut col);
+                }
+            } else {
+                step(&mut i, &mut line, &mut col);
+                while i < chars.len() && chars[i].1 != c {
+                    if chars[i].1 == '\\' {
+                        step(&mut i, &mut line, &mut col);
+                    }
+                    if i < chars.len() {
+                        step(&mut i, &mut line, &mut col);
+                    }
                 }
                 if i < chars.len() {
                     step(&mut i, &mut line, &mut col);
                 }
-            }
-            if i < chars.len() {
-                step(&mut i, &mut line, &mut col);
-            }
-            let end = chars.get(i).map_or(text.len(), |x| x.0);
-            out.push(Token {
-                kind: Kind::Other,
-                text: &text[start..end],
-                line: sl,
-                col: sc,
-            });
-        } else if let Some(hashes) = raw_string_hashes(&chars[i..]) {
-            // A raw string, r"…" or r#"…"#: no escapes, and it ends only at a quote
-            // followed by as many `#` as opened it.
-            for _ in 0..hashes + 2 {
-                step(&mut i, &mut line, &mut col);
-            }
-            while i < chars.len() {
-                let closes = chars[i].1 == '"'
-                    && (1..=hashes).all(|k| chars.get(i + k).is_some_and(|x| x.1 == '#'));
-                if closes {
-                    for _ in 0..hashes + 1 {
-                        step(&mut i, &mut line, &mut col);
-                    }
-                    break;
-                }
-                step(&mut i, &mut line, &mut col);
             }
             let end = chars.get(i).map_or(text.len(), |x| x.0);
             out.push(Token {
