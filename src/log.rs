@@ -101,16 +101,17 @@ impl Columns {
     }
 }
 
-/// A reader that records where every line of its input begins, so that a byte offset
-/// names its line whatever the line endings. The `csv` crate counts a line only at a
-/// `\n`, and only after it has recorded the next record's position: every line of a
-/// `\r\n` file was reported one early and every line of a `\r` file as line 1
-/// (BurntSushi/rust-csv#395). Here `\n`, `\r\n` and a lone `\r` each end one line.
-struct LineIndex<R> {
+/// A reader that records where every line of its input ends, so that a byte offset names
+/// its line whatever the line endings. The `csv` crate counts a line only at a `\n`, and
+/// only after it has recorded the next record's position: every line of a `\r\n` file was
+/// reported one early, every line of a `\r` file as line 1, and a record after blank
+/// lines at the first blank one (BurntSushi/rust-csv#395). Here `\n`, `\r\n` and a lone
+/// `\r` each end one line.
+pub struct LineIndex<R> {
     inner: R,
-    /// Byte offset of the first byte of every line terminator seen so far (a `\r\n` is
-    /// recorded at its `\r`), in increasing order.
-    ends: Vec<u64>,
+    /// Offset and length (1, or 2 for `\r\n`) of every line terminator seen so far, in
+    /// increasing order.
+    ends: Vec<(u64, u8)>,
     /// Bytes read so far.
     offset: u64,
     /// Whether the last byte read was a `\r`.
@@ -118,7 +119,7 @@ struct LineIndex<R> {
 }
 
 impl<R> LineIndex<R> {
-    fn new(inner: R) -> Self {
+    pub fn new(inner: R) -> Self {
         Self {
             inner,
             ends: Vec::new(),
@@ -127,9 +128,19 @@ impl<R> LineIndex<R> {
         }
     }
 
-    /// The 1-based line holding byte `offset` (of the bytes already read).
-    fn line_of(&self, offset: u64) -> u64 {
-        self.ends.partition_point(|&e| e < offset) as u64 + 1
+    /// The 1-based line of a record the `csv` crate places at byte `offset` (of the bytes
+    /// already read): the line of the first byte at or after `offset` that does not end a
+    /// line, since csv places a record after blank lines at the first of them.
+    pub fn line_of(&self, offset: u64) -> u64 {
+        let mut i = self.ends.partition_point(|e| e.0 < offset);
+        let mut at = offset;
+        while let Some(&(end, len)) = self.ends.get(i)
+            && end == at
+        {
+            at += u64::from(len);
+            i += 1;
+        }
+        i as u64 + 1
     }
 }
 
@@ -138,8 +149,12 @@ impl<R: std::io::Read> std::io::Read for LineIndex<R> {
         let n = self.inner.read(buf)?;
         for (i, &b) in buf[..n].iter().enumerate() {
             let at = self.offset + i as u64;
-            if b == b'\r' || (b == b'\n' && !self.after_cr) {
-                self.ends.push(at);
+            if b == b'\n' && self.after_cr {
+                if let Some(last) = self.ends.last_mut() {
+                    last.1 = 2;
+                }
+            } else if b == b'\r' || b == b'\n' {
+                self.ends.push((at, 1));
             }
             self.after_cr = b == b'\r';
         }

@@ -101,8 +101,20 @@ fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, Pipelin
 
 /// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the
 /// world's own `seed` field, which `--seed` overrides), if there is one.
+/// A `seed` that is present but not a non-negative integer is an error, not a missing seed.
 pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
-    Ok(read_meta(dir)?.and_then(|(_, meta)| meta.get("seed").and_then(serde_json::Value::as_u64)))
+    let Some((path, meta)) = read_meta(dir)? else {
+        return Ok(None);
+    };
+    match meta.get("seed") {
+        None | Some(serde_json::Value::Null) => Ok(None),
+        Some(v) => v.as_u64().map(Some).ok_or_else(|| PipelineError::Meta {
+            path,
+            message: format!(
+                "`seed` is {v}, not a non-negative integer; write the seed the simulation ran with, or remove the field"
+            ),
+        }),
+    }
 }
 
 /// Reads the world a simulation ran with from its `meta.json`, if there is one.

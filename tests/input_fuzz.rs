@@ -1498,6 +1498,18 @@ fn cr_only_line_endings_report_the_right_line() {
     );
 }
 
+/// Regression: csv places a record that follows blank lines at the first blank one, so its
+/// error named that line (found for `swarmmap persistence` by `tests/input_fuzz_cli.rs`;
+/// the log reader shares its `LineIndex`).
+#[test]
+fn blank_lines_do_not_shift_the_line() {
+    let err = encounters_error("start,end,a,b\n0,1,0,1\n\n\r\n\r0,x,0,1\n");
+    assert!(
+        err.ends_with("encounters.csv:6: column `end` is `x`, which is not a number"),
+        "{err}"
+    );
+}
+
 /// Regression (found by reading src/world/locate.rs): its tokenizer did not know RON's raw
 /// strings, so field text inside `r#"..."#` was taken for fields and the error pointed into
 /// the string (line 2) instead of at the real `width` (line 3).

@@ -16,6 +16,7 @@ use anyhow::{Context, anyhow};
 use clap::Args;
 
 use super::{Failure, input};
+use swarmmap::log::LineIndex;
 use swarmmap::topology::rips::{Diagram, RipsOptions, rips_matrix, rips_points};
 use swarmmap::topology::{DistanceMatrix, MatrixError, PointCloud};
 
@@ -53,9 +54,9 @@ pub fn run(args: PersistenceArgs) -> Result<(), Failure> {
     }
     .check()
     .map_err(input)?;
-    let text = std::fs::read_to_string(&args.file)
+    let bytes = std::fs::read(&args.file)
         .with_context(|| format!("cannot read {}", args.file.display()))?;
-    let rows = parse_rows(&text).map_err(|e| input(anyhow!("{}:{e}", args.file.display())))?;
+    let rows = parse_rows(&bytes).map_err(|e| input(anyhow!("{}:{e}", args.file.display())))?;
     let diagram = if args.distance_matrix {
         let m = matrix(&rows).map_err(|e| input(located(&args.file, &rows, e)))?;
         rips_matrix(&m, &opts)
@@ -72,17 +73,34 @@ pub fn run(args: PersistenceArgs) -> Result<(), Failure> {
 /// A CSV row: its 1-based line number and its numbers.
 type Row = (u64, Vec<f64>);
 
-/// Parses rows of numbers; errors read `LINE: message` (blank lines are skipped).
-fn parse_rows(text: &str) -> Result<Vec<Row>, String> {
+/// Parses rows of numbers; errors read `LINE: message` (blank lines are skipped). Lines
+/// are numbered from byte offsets ([`LineIndex`]), so `\r\n`, `\r` and blank
+/// lines do not shift them.
+fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
+        .from_reader(LineIndex::new(bytes));
     let mut rows: Vec<Row> = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| format!("{}: {e}", e.position().map_or(0, |p| p.line())))?;
-        let line = rec.position().map_or(0, |p| p.line());
+    let mut rec = csv::StringRecord::new();
+    loop {
+        let at = rdr.position().byte();
+        match rdr.read_record(&mut rec) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => {
+                let line = rdr.get_ref().line_of(e.position().map_or(at, |p| p.byte()));
+                let what = match e.kind() {
+                    csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+                    _ => e.to_string(),
+                };
+                return Err(format!("{line}: {what}"));
+            }
+        }
+        let line = rdr
+            .get_ref()
+            .line_of(rec.position().map_or(at, |p| p.byte()));
         let mut vals = Vec::with_capacity(rec.len());
         for (col, field) in rec.iter().enumerate() {
             let v: f64 = field.parse().map_err(|_| {

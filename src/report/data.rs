@@ -164,6 +164,23 @@ fn read_json<T: DeserializeOwned>(path: &Path, hint: &'static str) -> Result<T, 
     serde_json::from_str(&text).map_err(|e| invalid(path, format!("not a swarmmap output: {e}")))
 }
 
+/// `summary.json` (at `summary`) lists a `what` numbered `index` whose file `path` must
+/// exist: a missing one is `summary.json`'s fault when the `maps/` directory holds other
+/// files (a corrupted or hand-edited summary), and a missing map otherwise.
+fn listed_exists(summary: &Path, path: &Path, what: &str, index: usize) -> Result<(), ReportError> {
+    let maps = path.parent().filter(|m| m.is_dir());
+    if path.exists() || maps.is_none() {
+        return Ok(());
+    }
+    Err(invalid(
+        summary,
+        format!(
+            "lists {what} {index}, but {} does not exist; the summary and maps/ disagree: rerun `swarmmap map RUN_DIR`",
+            path.display()
+        ),
+    ))
+}
+
 fn invalid(path: &Path, message: impl Into<String>) -> ReportError {
     ReportError::Invalid {
         path: path.to_path_buf(),
@@ -357,12 +374,16 @@ pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
     let mut windows = Vec::with_capacity(summary.windows.len());
     for w in &summary.windows {
         let path = dir.join(format!("maps/window_{}.json", w.index));
+        listed_exists(&summary_path, &path, "window", w.index)?;
         let win: WindowIn = read_json(&path, REMAP)?;
         check_window(&path, &win)?;
         if win.index != w.index {
             return Err(invalid(
                 &path,
-                format!("its index is {}, expected {}", win.index, w.index),
+                format!(
+                    "its index is {}, but summary.json lists it as window {}; rerun `swarmmap map RUN_DIR`",
+                    win.index, w.index
+                ),
             ));
         }
         windows.push(win);
@@ -370,6 +391,7 @@ pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
     let mut connections = Vec::with_capacity(summary.connections.len());
     for c in &summary.connections {
         let path = dir.join(format!("maps/connection_{}.json", c.between[0]));
+        listed_exists(&summary_path, &path, "connection", c.between[0])?;
         let conn: ConnectionIn = read_json(&path, REMAP)?;
         check_connection(&path, &conn)?;
         connections.push(conn);
