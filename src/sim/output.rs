@@ -98,7 +98,7 @@ pub fn world_json(world: &World) -> Value {
         Placement::Window => json!("Window"),
     };
     let m = &world.mapping;
-    json!({
+    let mut v = json!({
         "name": world.name,
         "arena": {"width": world.arena.width, "height": world.arena.height},
         "obstacles": obstacles,
@@ -137,7 +137,12 @@ pub fn world_json(world: &World) -> Value {
             "switch_cost": m.switch_cost,
         },
         "seed": world.seed,
-    })
+    });
+    // Written only when set, so that the runs of earlier builds keep their bytes.
+    if m.after_landmarks {
+        v["mapping"]["after_landmarks"] = json!(true);
+    }
+    v
 }
 
 /// `meta.json`. Everything but the `timings` object is deterministic.

@@ -623,6 +623,7 @@ impl WorldSpec {
             neighbours,
             method,
             switch_cost,
+            after_landmarks: m.after_landmarks.unwrap_or(md.after_landmarks),
         };
 
         let world = World {

@@ -110,6 +110,7 @@ pub struct MappingSpec {
     pub neighbours: Option<i64>,
     pub method: Option<MethodSpec>,
     pub switch_cost: Option<f64>,
+    pub after_landmarks: Option<bool>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -267,6 +268,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.neighbours",
     "mapping.method",
     "mapping.switch_cost",
+    "mapping.after_landmarks",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -385,6 +387,7 @@ impl WorldSpec {
                             "neighbours" => put(&mut s.neighbours, p, v)?,
                             "method" => put(&mut s.method, p, v)?,
                             "switch_cost" => put(&mut s.switch_cost, p, v)?,
+                            "after_landmarks" => put(&mut s.after_landmarks, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

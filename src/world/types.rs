@@ -159,6 +159,10 @@ pub struct MappingParams {
     /// Cost in seconds of every change of agent along a path of the encounter graph
     /// (`mapping::encounter_graph`, "Agent switches"; default: `0.0`, the paper's metric).
     pub switch_cost: f64,
+    /// Map only the encounters that end once the first landmark is selected, as the paper
+    /// records them (`mapping::local::first_landmark_start`; default: `false`, every
+    /// encounter of the log, the dispersion's included).
+    pub after_landmarks: bool,
 }
 
 impl Default for MappingParams {
@@ -171,6 +175,7 @@ impl Default for MappingParams {
             neighbours: 5,
             method: MappingMethod::Paper,
             switch_cost: 0.0,
+            after_landmarks: false,
         }
     }
 }
