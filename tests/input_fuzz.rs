@@ -1465,49 +1465,33 @@ fn encounters_error(text: &str) -> String {
     got.unwrap_err().to_string()
 }
 
-/// Regression (found by the `mutated_*` properties, shrunk to `start,end,a,b\r\n,0.01,0,1`,
-/// reported at line 1): csv-core counts a line when it consumes a `\n`, which with CRLF
-/// happens only after it has taken the next record's position, so every error in a
-/// Windows file was one line early (upstream: BurntSushi/rust-csv#395). The reader now
-/// numbers lines from byte offsets itself.
+/// Regressions of the CSV line numbers. csv-core counts a line when it consumes a `\n`,
+/// which with CRLF happens only after it has taken the next record's position, so every
+/// error in a Windows file was one line early (found by the `mutated_*` properties, shrunk
+/// to `start,end,a,b\r\n,0.01,0,1`; upstream BurntSushi/rust-csv#395); it counts lines by
+/// `\n` only, so in a CR-only file (classic Mac OS, Excel's "CSV (Macintosh)") every error
+/// was at line 1; and it places a record that follows blank lines at the first blank one
+/// (found for `swarmmap persistence` by `tests/input_fuzz_cli.rs`). The reader now numbers
+/// lines from byte offsets (`LineIndex`).
 #[test]
-fn crlf_line_endings_report_the_right_line() {
-    let text = "start,end,a,b\r\n0,1,0,1\r\n0,x,0,1\r\n";
-    let err = encounters_error(text);
-    assert!(
-        err.ends_with("encounters.csv:3: column `end` is `x`, which is not a number"),
-        "{err}"
-    );
-    let text = "start,end,a,b\r\n0,1,0,1\r\n0,1,0\r\n";
-    let err = encounters_error(text);
-    assert!(
-        err.contains("encounters.csv:3: this row has 3 fields"),
-        "{err}"
-    );
-}
-
-/// Regression: csv-core counts lines by `\n` only, so in a file with CR-only line endings
-/// (classic Mac OS, Excel's "CSV (Macintosh)") every error was reported at line 1.
-#[test]
-fn cr_only_line_endings_report_the_right_line() {
-    let text = "start,end,a,b\r0,1,0,1\r0,x,0,1\r";
-    let err = encounters_error(text);
-    assert!(
-        err.ends_with("encounters.csv:3: column `end` is `x`, which is not a number"),
-        "{err}"
-    );
-}
-
-/// Regression: csv places a record that follows blank lines at the first blank one, so its
-/// error named that line (found for `swarmmap persistence` by `tests/input_fuzz_cli.rs`;
-/// the log reader shares its `LineIndex`).
-#[test]
-fn blank_lines_do_not_shift_the_line() {
-    let err = encounters_error("start,end,a,b\n0,1,0,1\n\n\r\n\r0,x,0,1\n");
-    assert!(
-        err.ends_with("encounters.csv:6: column `end` is `x`, which is not a number"),
-        "{err}"
-    );
+fn line_endings_and_blank_lines_do_not_shift_the_line() {
+    let not_a_number = "column `end` is `x`, which is not a number";
+    for (text, line, message) in [
+        ("start,end,a,b\r\n0,1,0,1\r\n0,x,0,1\r\n", 3, not_a_number),
+        (
+            "start,end,a,b\r\n0,1,0,1\r\n0,1,0\r\n",
+            3,
+            "this row has 3 fields",
+        ),
+        ("start,end,a,b\r0,1,0,1\r0,x,0,1\r", 3, not_a_number),
+        ("start,end,a,b\n0,1,0,1\n\n\r\n\r0,x,0,1\n", 6, not_a_number),
+    ] {
+        let err = encounters_error(text);
+        assert!(
+            err.contains(&format!("encounters.csv:{line}: {message}")),
+            "{text:?}: {err}"
+        );
+    }
 }
 
 /// Regression (found by reading src/world/locate.rs): its tokenizer did not know RON's raw
