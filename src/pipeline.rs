@@ -101,6 +101,7 @@ fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, Pipelin
 
 /// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the
 /// world's own `seed` field, which `--seed` overrides), if there is one.
+///
 /// A `seed` that is present but not a non-negative integer is an error, not a missing seed.
 pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
     let Some((path, meta)) = read_meta(dir)? else {

@@ -417,20 +417,29 @@ fn centi(k: i32) -> String {
     (f64::from(k) / 100.0).to_string()
 }
 
-/// Puts the columns of `header` and `rows` in the order given by `perm` (a permutation of
-/// `0..8`, restricted to the table's columns).
-fn permuted(
-    header: Vec<&str>,
-    rows: Vec<Vec<String>>,
-    perm: &[usize],
-) -> (Vec<String>, Vec<Vec<String>>) {
-    let order: Vec<usize> = perm.iter().copied().filter(|&i| i < header.len()).collect();
-    let header = order.iter().map(|&i| header[i].to_string()).collect();
-    let rows = rows
-        .into_iter()
-        .map(|r| order.iter().map(|&i| r[i].clone()).collect())
-        .collect();
-    (header, rows)
+impl Table {
+    /// The table of `header` and `rows` with its columns in the order given by `perm` (a
+    /// permutation of `0..8`, restricted to the table's columns).
+    fn permuted(
+        file: LogFile,
+        header: Vec<&str>,
+        rows: Vec<Vec<String>>,
+        perm: &[usize],
+        eol: &'static str,
+        final_eol: bool,
+    ) -> Self {
+        let order: Vec<usize> = perm.iter().copied().filter(|&i| i < header.len()).collect();
+        Self {
+            file,
+            header: order.iter().map(|&i| header[i].to_string()).collect(),
+            rows: rows
+                .into_iter()
+                .map(|r| order.iter().map(|&i| r[i].clone()).collect())
+                .collect(),
+            eol,
+            final_eol,
+        }
+    }
 }
 
 fn permutation() -> impl Strategy<Value = Vec<usize>> {
@@ -478,14 +487,7 @@ fn valid_table(file: LogFile, eols: &'static [&'static str]) -> BoxedStrategy<Ta
                             r
                         })
                         .collect();
-                    let (header, rows) = permuted(header, rows, &perm);
-                    Table {
-                        file,
-                        header,
-                        rows,
-                        eol,
-                        final_eol,
-                    }
+                    Table::permuted(file, header, rows, &perm, eol, final_eol)
                 })
                 .boxed()
         }
@@ -513,14 +515,7 @@ fn valid_table(file: LogFile, eols: &'static [&'static str]) -> BoxedStrategy<Ta
                             r
                         })
                         .collect();
-                    let (header, rows) = permuted(header, rows, &perm);
-                    Table {
-                        file,
-                        header,
-                        rows,
-                        eol,
-                        final_eol,
-                    }
+                    Table::permuted(file, header, rows, &perm, eol, final_eol)
                 })
                 .boxed()
         }
@@ -537,14 +532,7 @@ fn valid_table(file: LogFile, eols: &'static [&'static str]) -> BoxedStrategy<Ta
                         .into_iter()
                         .map(|(t, x)| vec![centi(t), centi(x)])
                         .collect();
-                    let (header, rows) = permuted(vec!["time", "x"], rows, &perm);
-                    Table {
-                        file,
-                        header,
-                        rows,
-                        eol,
-                        final_eol,
-                    }
+                    Table::permuted(file, vec!["time", "x"], rows, &perm, eol, final_eol)
                 })
                 .boxed()
         }

@@ -270,6 +270,22 @@ fn pair(i: &Index, j: &Index, n: usize) -> (usize, usize) {
 
 // ================================================================ persistence: properties
 
+/// `persistence` on `rows` (points, or a distance matrix with `matrix`): the general
+/// contract, then accepted when `expected` is `None`, else an error at line `expected`.
+fn assert_mutation_outcome(
+    rows: &[Vec<String>],
+    matrix: bool,
+    expected: Option<u64>,
+) -> Result<(), TestCaseError> {
+    let text = csv_text(rows);
+    let (path, o, _dir) = persistence(text.as_bytes(), matrix);
+    assert_persistence_contract(text.as_bytes(), &path, &o)?;
+    match expected {
+        None => assert_accepted(&o),
+        Some(line) => assert_error_at(&path, &o, line),
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(CLI_CASES))]
 
@@ -331,13 +347,7 @@ proptest! {
                 if r == 0 && parses_as_f64(t) { Some(2) } else { Some(r as u64 + 1) }
             }
         };
-        let text = csv_text(&rows);
-        let (path, o, _dir) = persistence(text.as_bytes(), false);
-        assert_persistence_contract(text.as_bytes(), &path, &o)?;
-        match expected {
-            None => assert_accepted(&o)?,
-            Some(line) => assert_error_at(&path, &o, line)?,
-        }
+        assert_mutation_outcome(&rows, false, expected)?;
     }
 
     /// One change of a valid distance matrix: accepted when it is still square, symmetric,
@@ -404,13 +414,7 @@ proptest! {
                 Some(if i == 0 { 2 } else { i as u64 + 1 })
             }
         };
-        let text = csv_text(&rows);
-        let (path, o, _dir) = persistence(text.as_bytes(), true);
-        assert_persistence_contract(text.as_bytes(), &path, &o)?;
-        match expected {
-            None => assert_accepted(&o)?,
-            Some(line) => assert_error_at(&path, &o, line)?,
-        }
+        assert_mutation_outcome(&rows, true, expected)?;
     }
 }
 

@@ -10,7 +10,9 @@ use swarmmap::log::StaticReason;
 use swarmmap::mapping::local::LocalParams;
 use swarmmap::mapping::pipeline::MapConfig;
 use swarmmap::mapping::stitch::StitchParams;
-use swarmmap::pipeline::{Timings, map_log, seed_from_run, world_from_run, write_maps};
+use swarmmap::pipeline::{
+    PipelineError, Timings, map_log, seed_from_run, world_from_run, write_maps,
+};
 use swarmmap::world::{MappingMethod, MappingParams};
 
 /// Options of `swarmmap map`.
@@ -130,7 +132,18 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     // The run's seed (a real log has none): a world file's `seed` field says nothing about
     // which seed produced this log.
     let seed = seed_from_run(&args.run_dir).map_err(input)?;
-    let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(input)?;
+    // The world's truth can fail (an arena too large to rasterise): name the file it came from.
+    let world_file = match &args.world {
+        Some(path) => path.clone(),
+        None => args.run_dir.join("meta.json"),
+    };
+    let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(|e| {
+        if matches!(e, PipelineError::Truth(_)) {
+            input(anyhow::anyhow!("{}: the world's {e}", world_file.display()))
+        } else {
+            input(e)
+        }
+    })?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
     // A report made from the previous maps would now be stale: regenerate it.

@@ -165,8 +165,9 @@ fn read_json<T: DeserializeOwned>(path: &Path, hint: &'static str) -> Result<T, 
 }
 
 /// `summary.json` (at `summary`) lists a `what` numbered `index` whose file `path` must
-/// exist: a missing one is `summary.json`'s fault when the `maps/` directory holds other
-/// files (a corrupted or hand-edited summary), and a missing map otherwise.
+/// exist. When `maps/` exists but that file does not, the summary names a map the run never
+/// wrote (a corrupted or hand-edited summary), so the error is the summary's; without
+/// `maps/`, `read_json` reports the missing map as such.
 fn listed_exists(summary: &Path, path: &Path, what: &str, index: usize) -> Result<(), ReportError> {
     let maps = path.parent().filter(|m| m.is_dir());
     if path.exists() || maps.is_none() {
