@@ -292,3 +292,87 @@ fn walkers_never_press_into_a_wall_they_touch() {
         "an agent pressed into a wall for {longest} steps"
     );
 }
+
+#[test]
+fn kept_surplus_landmarks_are_released_only_when_they_leave_the_domain() {
+    // The same sweep as above. Agents crossing D(t)'s edges move the count asked for by one
+    // now and then; by default the newest landmark is released at once (and replaced a
+    // moment later); with `keep_surplus_landmarks` only the domain's trailing edge
+    // releases landmarks.
+    let mut w = obstacle_world();
+    w.arena.width = 6.0;
+    w.obstacles.truncate(2);
+    w.leader.speed = 0.005;
+    w.leader.end_x = 4.5;
+    // The bundled worlds' 30 %: the count asked for, round(0.3 × agents inside), changes
+    // as soon as two of the 100 agents are outside.
+    w.swarm.landmark_fraction = 0.3;
+    let every = 0.1;
+    let default = run(&w, 11, every);
+    assert!(default.stats.landmark_releases_surplus > 0);
+    w.swarm.keep_surplus_landmarks = true;
+    let out = run(&w, 11, every);
+    assert_eq!(out.stats.landmark_releases_surplus, 0);
+    assert!(out.stats.landmark_releases_outside > 0);
+    let most = (w.swarm.landmark_fraction * w.swarm.agents as f64).round() as usize;
+    let traj = out.trajectories.as_ref().expect("trajectories");
+    let disp = w.simulation.dispersion_time;
+    let mut checked = 0;
+    for chunk in traj.samples.chunks(w.swarm.agents) {
+        let t = chunk[0].time;
+        if t < disp - 1e-9 || t >= out.stats.simulated_time - 1e-9 {
+            continue;
+        }
+        let (x0, x1) = w.domain(t);
+        let inside: Vec<_> = chunk.iter().filter(|s| s.x >= x0 && s.x <= x1).collect();
+        let landmarks: Vec<_> = chunk
+            .iter()
+            .filter(|s| s.state == AgentState::Landmark)
+            .collect();
+        let target = (w.swarm.landmark_fraction * inside.len() as f64).round() as usize;
+        assert!(
+            landmarks.iter().all(|s| s.x >= x0 && s.x <= x1),
+            "landmark outside D({t})"
+        );
+        assert!(
+            landmarks.len() >= target,
+            "at t = {t}: {} < {target}",
+            landmarks.len()
+        );
+        assert!(
+            landmarks.len() <= most,
+            "at t = {t}: {} > {most}",
+            landmarks.len()
+        );
+        checked += 1;
+    }
+    assert!(checked > 100);
+    // Every landmark interval that ends before the run does ends with its agent behind the
+    // domain's trailing edge (the sweep goes to +x); a static agent stands where it was.
+    let end = out.stats.simulated_time;
+    let mut released = 0;
+    for iv in out
+        .log
+        .static_intervals
+        .iter()
+        .filter(|s| s.reason == StaticReason::Landmark && s.end < end - 1e-9)
+    {
+        let Some(at) = traj
+            .samples
+            .iter()
+            .find(|s| s.agent == iv.agent && s.time >= iv.start && s.time < iv.end)
+        else {
+            continue; // shorter than the sampling interval
+        };
+        let (x0, _) = w.domain(iv.end);
+        assert!(
+            at.x < x0 + 1e-9,
+            "landmark {} released at t = {} at x = {}, inside D(t) from {x0}",
+            iv.agent,
+            iv.end,
+            at.x
+        );
+        released += 1;
+    }
+    assert!(released > 0);
+}

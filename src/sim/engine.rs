@@ -586,13 +586,14 @@ impl Run<'_> {
         }
     }
 
-    /// Holds round(fraction × agents inside D(t)) landmarks among the agents inside D(t).
+    /// Holds round(fraction × agents inside D(t)) landmarks among the agents inside D(t)
+    /// (at least that many with `keep_surplus_landmarks`, which releases none for a surplus).
     fn upkeep_landmarks(&mut self, pos: &[P], t: f64, domain: P, leader_x: f64) {
         let is_inside = |p: &P| p.0 >= domain.0 && p.0 <= domain.1;
         // Counted without allocating: the candidates are only listed when a pick is due.
         let n_inside = pos.iter().filter(|p| is_inside(p)).count();
         let target = (self.world.swarm.landmark_fraction * n_inside as f64).round() as usize;
-        while self.landmarks.len() > target {
+        while self.landmarks.len() > target && !self.world.swarm.keep_surplus_landmarks {
             // Release the newest: the older landmarks keep their MaxMin spread.
             let Some(i) = self.landmarks.pop() else { break };
             self.close_static(i, t, StaticReason::Landmark);

@@ -16,8 +16,10 @@
 //! **Exploration.** Agents start uniformly in the free part of `swarm.placement` near the
 //! leader's start and disperse for `simulation.dispersion_time`. Then, at every step, the
 //! number of landmarks is held at round(`landmark_fraction` × agents inside D(t)): landmarks
-//! that fall out of D(t) resume walking, surplus landmarks (newest first) are released, and
-//! missing ones are chosen by MaxMin on the hop distance of the communication graph
+//! that fall out of D(t) resume walking, surplus landmarks (newest first) are released
+//! (unless `swarm.keep_surplus_landmarks`: the paper releases a landmark only when it leaves
+//! D(t); agents crossing D(t)'s edges make the target flicker, and with the default every
+//! flicker releases a landmark and picks another a moment later), and missing ones are chosen by MaxMin on the hop distance of the communication graph
 //! (`landmarks.rs`). The leader then sweeps from `start_x` to `end_x` at `leader.speed`; the
 //! run ends when it arrives.
 //!

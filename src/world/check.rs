@@ -489,6 +489,7 @@ impl WorldSpec {
             wall_following,
             wall_following_length,
             return_patience,
+            keep_surplus_landmarks: s.keep_surplus_landmarks.unwrap_or(d.keep_surplus_landmarks),
             placement,
         };
 

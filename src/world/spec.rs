@@ -70,6 +70,7 @@ pub struct SwarmSpec {
     pub wall_following: Option<f64>,
     pub wall_following_length: Option<f64>,
     pub return_patience: Option<f64>,
+    pub keep_surplus_landmarks: Option<bool>,
     pub placement: Option<PlacementSpec>,
 }
 
@@ -251,6 +252,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "swarm.wall_following",
     "swarm.wall_following_length",
     "swarm.return_patience",
+    "swarm.keep_surplus_landmarks",
     "swarm.placement",
     "leader",
     "leader.speed",
@@ -355,6 +357,7 @@ impl WorldSpec {
                             "wall_following" => put(&mut s.wall_following, p, v)?,
                             "wall_following_length" => put(&mut s.wall_following_length, p, v)?,
                             "return_patience" => put(&mut s.return_patience, p, v)?,
+                            "keep_surplus_landmarks" => put(&mut s.keep_surplus_landmarks, p, v)?,
                             "placement" => put(&mut s.placement, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }

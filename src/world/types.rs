@@ -75,6 +75,11 @@ pub struct SwarmParams {
     /// regaining D(t) before it walks at random for a while to leave a nook the gradient
     /// keeps it in (default: `300.0`; a very large value disables the escape).
     pub return_patience: f64,
+    /// Keep the landmarks when D(t) holds fewer agents than their count asks for, instead
+    /// of releasing the newest (default: `false`). A landmark is then released only when
+    /// it leaves D(t) (the paper's rule), and shortfalls are still filled; the count stays
+    /// at most `round(landmark_fraction × agents)`.
+    pub keep_surplus_landmarks: bool,
     /// Initial placement (default: `Disk(radius: 1.0)`).
     pub placement: Placement,
 }
@@ -94,6 +99,7 @@ impl Default for SwarmParams {
             wall_following: 0.0,
             wall_following_length: 1.0,
             return_patience: 300.0,
+            keep_surplus_landmarks: false,
             placement: Placement::Disk { radius: 1.0 },
         }
     }
