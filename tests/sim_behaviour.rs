@@ -180,14 +180,19 @@ fn agents_never_enter_obstacles_nor_leave_the_arena() {
     assert!(out.stats.collisions > 0);
 }
 
-#[test]
-fn landmark_fraction_holds_inside_the_leaders_domain() {
-    // The paper's speeds (leader 0.005 m/s, agents 0.1 m/s) on a 6 m arena: a 600 s sweep.
+/// The paper's speeds (leader 0.005 m/s, agents 0.1 m/s) on a 6 m arena: a 600 s sweep.
+fn sweep_world() -> World {
     let mut w = obstacle_world();
     w.arena.width = 6.0;
     w.obstacles.truncate(2);
     w.leader.speed = 0.005;
     w.leader.end_x = 4.5;
+    w
+}
+
+#[test]
+fn landmark_fraction_holds_inside_the_leaders_domain() {
+    let w = sweep_world();
     // Return episodes last a few seconds at most (the domain's edge moves 5 mm/s), so the
     // closing speed below is measured over 0.1 s samples: at 0.5 s a run had only 1 to 10
     // sample pairs in `return`, too few to measure anything.
@@ -295,15 +300,10 @@ fn walkers_never_press_into_a_wall_they_touch() {
 
 #[test]
 fn kept_surplus_landmarks_are_released_only_when_they_leave_the_domain() {
-    // The same sweep as above. Agents crossing D(t)'s edges move the count asked for by one
-    // now and then; by default the newest landmark is released at once (and replaced a
-    // moment later); with `keep_surplus_landmarks` only the domain's trailing edge
-    // releases landmarks.
-    let mut w = obstacle_world();
-    w.arena.width = 6.0;
-    w.obstacles.truncate(2);
-    w.leader.speed = 0.005;
-    w.leader.end_x = 4.5;
+    // Agents crossing D(t)'s edges move the count asked for by one now and then; by
+    // default the newest landmark is released at once (and replaced a moment later); with
+    // `keep_surplus_landmarks` only the domain's trailing edge releases landmarks.
+    let mut w = sweep_world();
     // The bundled worlds' 30 %: the count asked for, round(0.3 × agents inside), changes
     // as soon as two of the 100 agents are outside.
     w.swarm.landmark_fraction = 0.3;
