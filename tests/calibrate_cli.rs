@@ -132,3 +132,48 @@ fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
         .code(2)
         .stderr(contains("at least two groups"));
 }
+
+#[test]
+fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    let land = dir.path().join("landscape.csv");
+    std::fs::write(&out, SHIPPED).unwrap();
+    calibrate(
+        &out,
+        &[
+            "--max-false-holes",
+            "1",
+            "--landscape",
+            land.to_str().unwrap(),
+        ],
+    );
+    let text = std::fs::read_to_string(&land).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("method,h1_ratio,h1_span,windows,b1_right,holeless,false_holes,within_cap")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // Death / birth 1 to 8 in steps of 0.1, a life of 0 to 20 σ in steps of 0.25 σ.
+    assert_eq!(rows.len(), 71 * 81);
+    assert!(
+        rows.iter()
+            .all(|r| r.len() == 8 && r[0] == "Paper" && r[3] == "4")
+    );
+    // Unconstrained, every point is within the cap, and the fitted rule scores the most.
+    assert!(rows.iter().all(|r| r[7] == "true"));
+    let best = rows
+        .iter()
+        .map(|r| r[4].parse::<usize>().unwrap())
+        .max()
+        .unwrap();
+    let c = models(&out).paper.classifier;
+    let fitted = rows
+        .iter()
+        .find(|r| {
+            r[1].parse::<f64>().unwrap() == c.h1_ratio && r[2].parse::<f64>().unwrap() == c.h1_span
+        })
+        .expect("the fitted rule is a grid point");
+    assert_eq!(fitted[4].parse::<usize>().unwrap(), best);
+}

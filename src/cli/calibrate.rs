@@ -6,7 +6,7 @@ use anyhow::{Context, anyhow};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use std::path::PathBuf;
-use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit};
+use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit, h1_landscape};
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::Models;
@@ -46,6 +46,11 @@ pub struct CalibrateArgs {
     /// windows. Repeat the option for both. The model written is still the fit on all.
     #[arg(long = "cross-validate", value_enum, value_name = "GROUPS")]
     pub cross_validate: Vec<CvGroups>,
+    /// Also write the H1 grid the fit searches to this CSV, one row per (h1_ratio, h1_span)
+    /// with the training windows it gets right and its false-hole share, to see how flat
+    /// the optimum is and which other rules score nearly as well.
+    #[arg(long, value_name = "CSV")]
+    pub landscape: Option<PathBuf>,
 }
 
 /// How `--cross-validate` groups the training windows into folds.
@@ -176,6 +181,9 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         }
     }
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    // One file for every method fitted (`--landscape`), written once at the end.
+    let mut csv =
+        String::from("method,h1_ratio,h1_span,windows,b1_right,holeless,false_holes,within_cap\n");
     for Training {
         target: method,
         samples,
@@ -193,10 +201,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         println!(
             "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
              both right {:.1} %, β0 {:.1} %, β1 {:.1} %, false holes {:.1} % of hole-free windows",
-            match method {
-                Target::Method(m) => format!("{m:?}"),
-                Target::Oracle => "Oracle".to_string(),
-            },
+            target_name(method),
             f.classifier.h0_ratio,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
@@ -206,6 +211,22 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         );
+        if args.landscape.is_some() {
+            let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
+            for p in h1_landscape(samples) {
+                csv.push_str(&format!(
+                    "{},{},{},{},{},{},{},{}\n",
+                    target_name(method),
+                    p.h1_ratio,
+                    p.h1_span,
+                    samples.len(),
+                    p.b1_right,
+                    holeless,
+                    (p.false_holes * holeless as f64).round() as usize,
+                    p.false_holes <= args.max_false_holes + 1e-12
+                ));
+            }
+        }
         let mut held_out = String::new();
         for &groups in &args.cross_validate {
             let labels: Vec<String> = origin
@@ -250,6 +271,11 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         ) + &held_out;
+    }
+    if let Some(path) = &args.landscape {
+        write_atomic(path, csv.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("H1 landscape written to {}", path.display());
     }
     let mut text = serde_json::to_string_pretty(&models).map_err(|e| Failure::Other(e.into()))?;
     text.push('\n');
@@ -311,4 +337,12 @@ struct Training {
 enum Target {
     Method(MappingMethod),
     Oracle,
+}
+
+/// The model entry a fit replaces, as printed and in `--landscape` rows.
+fn target_name(target: &Target) -> String {
+    match target {
+        Target::Method(m) => format!("{m:?}"),
+        Target::Oracle => "Oracle".to_string(),
+    }
 }

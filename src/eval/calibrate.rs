@@ -86,6 +86,118 @@ fn grid(lo: f64, hi: f64, step: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The H1 grid of [`fit`]: death / birth from 1 to 8 in steps of 0.1.
+fn h1_ratios() -> Vec<f64> {
+    grid(1.0, 8.0, 0.1)
+}
+
+/// The H1 grid of [`fit`]: a life of 0 to 20 σ in steps of 0.25 σ.
+fn h1_spans() -> Vec<f64> {
+    grid(0.0, 20.0, 0.25)
+}
+
+/// The training windows with each component's sampling scale computed and its features
+/// split by dimension once: the grid search judges every sample at every grid point.
+struct Prepared<'a> {
+    samples: &'a [Sample],
+    scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>>,
+    /// Indices of the samples whose truth has no hole.
+    holeless: Vec<usize>,
+}
+
+impl<'a> Prepared<'a> {
+    fn new(samples: &'a [Sample]) -> Self {
+        let scaled = samples
+            .iter()
+            .map(|s| {
+                s.components
+                    .iter()
+                    .map(|f| {
+                        let by_dim = |d: usize| f.iter().filter(|x| x.dim == d).copied().collect();
+                        (sampling_scale(f), [by_dim(0), by_dim(1)])
+                    })
+                    .collect()
+            })
+            .collect();
+        let holeless = (0..samples.len())
+            .filter(|&k| samples[k].truth[1] == 0)
+            .collect();
+        Self {
+            samples,
+            scaled,
+            holeless,
+        }
+    }
+
+    /// Samples whose Betti number of dimension `dim` under `pick` equals the truth.
+    fn count(&self, pick: &dyn Fn(&Feature, f64) -> bool, dim: usize) -> usize {
+        self.samples
+            .iter()
+            .zip(&self.scaled)
+            .filter(|(s, comps)| {
+                let b: usize = comps
+                    .iter()
+                    .map(|(sigma, fs)| fs[dim].iter().filter(|f| pick(f, *sigma)).count())
+                    .sum();
+                b == s.truth[dim]
+            })
+            .count()
+    }
+
+    /// Share of the hole-free samples in which `c` shows a hole.
+    fn false_share(&self, c: &Classifier) -> f64 {
+        if self.holeless.is_empty() {
+            return 0.0;
+        }
+        let shown = self
+            .holeless
+            .iter()
+            .filter(|&&k| {
+                self.scaled[k]
+                    .iter()
+                    .any(|(sigma, fs)| fs[1].iter().any(|f| c.robust(f, *sigma)))
+            })
+            .count();
+        shown as f64 / self.holeless.len() as f64
+    }
+}
+
+/// One point of the H1 grid that [`fit`] searches, with what it scores on the training
+/// windows (`swarmmap calibrate --landscape`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LandscapePoint {
+    pub h1_ratio: f64,
+    pub h1_span: f64,
+    /// Training windows whose β1 this rule gets right.
+    pub b1_right: usize,
+    /// Share of the hole-free training windows in which it shows a hole.
+    pub false_holes: f64,
+}
+
+/// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span): the
+/// landscape the fit maximises over, to see whether its optimum is a broad plateau or one
+/// of several near-equal peaks.
+pub fn h1_landscape(samples: &[Sample]) -> Vec<LandscapePoint> {
+    let prepared = Prepared::new(samples);
+    let mut out = Vec::new();
+    for h1_ratio in h1_ratios() {
+        for h1_span in h1_spans() {
+            let c = Classifier {
+                h0_ratio: 0.0,
+                h1_ratio,
+                h1_span,
+            };
+            out.push(LandscapePoint {
+                h1_ratio,
+                h1_span,
+                b1_right: prepared.count(&|f, s| c.robust(f, s), 1),
+                false_holes: prepared.false_share(&c),
+            });
+        }
+    }
+    out
+}
+
 /// Fits the three thresholds on `samples`. β0 and β1 are decided by disjoint parameters
 /// (`h0_ratio`; `h1_ratio` and `h1_span`), so they are fitted separately and combined; the
 /// reported accuracy is that of the combination. The H1 thresholds are searched only where at
@@ -95,33 +207,8 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
     if samples.is_empty() {
         return None;
     }
-    // Precompute each component's sampling scale and split its features by dimension once:
-    // the grid search below judges every sample at every grid point.
-    let scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>> = samples
-        .iter()
-        .map(|s| {
-            s.components
-                .iter()
-                .map(|f| {
-                    let by_dim = |d: usize| f.iter().filter(|x| x.dim == d).copied().collect();
-                    (sampling_scale(f), [by_dim(0), by_dim(1)])
-                })
-                .collect()
-        })
-        .collect();
-    let count = |pick: &dyn Fn(&Feature, f64) -> bool, dim: usize| -> usize {
-        samples
-            .iter()
-            .zip(&scaled)
-            .filter(|(s, comps)| {
-                let b: usize = comps
-                    .iter()
-                    .map(|(sigma, fs)| fs[dim].iter().filter(|f| pick(f, *sigma)).count())
-                    .sum();
-                b == s.truth[dim]
-            })
-            .count()
-    };
+    let prepared = Prepared::new(samples);
+    let count = |pick: &dyn Fn(&Feature, f64) -> bool, dim: usize| prepared.count(pick, dim);
     let base = Classifier {
         h0_ratio: 0.0,
         h1_ratio: 0.0,
@@ -143,26 +230,10 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
         })
         .collect();
     let h0_ratio = best_middle(h0)[0];
-    let holeless: Vec<usize> = (0..samples.len())
-        .filter(|&k| samples[k].truth[1] == 0)
-        .collect();
-    let false_share = |c: &Classifier| -> f64 {
-        if holeless.is_empty() {
-            return 0.0;
-        }
-        let shown = holeless
-            .iter()
-            .filter(|&&k| {
-                scaled[k]
-                    .iter()
-                    .any(|(sigma, fs)| fs[1].iter().any(|f| c.robust(f, *sigma)))
-            })
-            .count();
-        shown as f64 / holeless.len() as f64
-    };
+    let false_share = |c: &Classifier| prepared.false_share(c);
     let mut h1 = Vec::new();
-    for r in grid(1.0, 8.0, 0.1) {
-        for span in grid(0.0, 20.0, 0.25) {
+    for r in h1_ratios() {
+        for span in h1_spans() {
             let c = Classifier {
                 h1_ratio: r,
                 h1_span: span,
@@ -342,6 +413,60 @@ mod tests {
         assert_eq!(fit.accuracy, 1.0, "{fit:?}");
         assert_eq!(fit.false_holes, 0.0);
         assert!(fit.classifier.h1_ratio > 2.0 && fit.classifier.h1_ratio <= 4.0);
+    }
+
+    /// The landscape scores every grid point as judging each window one by one would, and
+    /// the fit's thresholds lie on its best point within the cap.
+    #[test]
+    fn the_landscape_is_the_grid_the_fit_maximises_over() {
+        let mut samples = Vec::new();
+        for k in 0..6 {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            v.push(f(1, 1.0, 1.5 + 0.4 * k as f64));
+            let hole = k % 2 == 0;
+            if hole {
+                v.push(f(1, 0.5, 2.0 + 0.5 * k as f64));
+            }
+            samples.push(Sample {
+                components: vec![v],
+                truth: [1, usize::from(hole)],
+            });
+        }
+        let land = h1_landscape(&samples);
+        assert_eq!(land.len(), h1_ratios().len() * h1_spans().len());
+        let holeless: Vec<&Sample> = samples.iter().filter(|s| s.truth[1] == 0).collect();
+        for p in &land {
+            let c = Classifier {
+                h0_ratio: 1e9,
+                h1_ratio: p.h1_ratio,
+                h1_span: p.h1_span,
+            };
+            let right = samples
+                .iter()
+                .filter(|s| s.betti(&c)[1] == s.truth[1])
+                .count();
+            let shown = holeless.iter().filter(|s| s.betti(&c)[1] > 0).count();
+            assert_eq!(p.b1_right, right, "{p:?}");
+            assert_eq!(p.false_holes, shown as f64 / holeless.len() as f64, "{p:?}");
+        }
+        for cap in [0.0, 0.34, 1.0] {
+            let fit = fit(&samples, cap).unwrap();
+            let best = land
+                .iter()
+                .filter(|p| p.false_holes <= cap + 1e-12)
+                .map(|p| p.b1_right)
+                .max()
+                .unwrap();
+            let at = land
+                .iter()
+                .find(|p| {
+                    p.h1_ratio == fit.classifier.h1_ratio && p.h1_span == fit.classifier.h1_span
+                })
+                .unwrap();
+            assert_eq!(at.b1_right, best, "cap {cap}: {fit:?}");
+            assert_eq!(fit.b1_accuracy, best as f64 / samples.len() as f64);
+        }
     }
 
     /// A hole-free window holds a noise loop (ratio 5.5) between the two real holes (ratios
