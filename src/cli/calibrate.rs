@@ -222,8 +222,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     samples.len(),
                     p.b1_right,
                     holeless,
-                    (p.false_holes * holeless as f64).round() as usize,
-                    p.false_holes <= args.max_false_holes + 1e-12
+                    p.false_holes,
+                    p.false_share <= args.max_false_holes + 1e-12
                 ));
             }
         }

@@ -151,21 +151,24 @@ impl<'a> Prepared<'a> {
             .count()
     }
 
-    /// Share of the hole-free samples in which `c` shows a hole.
-    fn false_share(&self, c: &Classifier) -> f64 {
-        if self.holeless.is_empty() {
-            return 0.0;
-        }
-        let shown = self
-            .holeless
+    /// Hole-free samples in which `c` shows a hole.
+    fn false_holes(&self, c: &Classifier) -> usize {
+        self.holeless
             .iter()
             .filter(|&&k| {
                 self.scaled[k]
                     .iter()
                     .any(|(sigma, fs)| fs[1].iter().any(|f| c.robust(f, *sigma)))
             })
-            .count();
-        shown as f64 / self.holeless.len() as f64
+            .count()
+    }
+
+    /// Share of the hole-free samples in which `c` shows a hole (0 if there are none).
+    fn false_share(&self, c: &Classifier) -> f64 {
+        if self.holeless.is_empty() {
+            return 0.0;
+        }
+        self.false_holes(c) as f64 / self.holeless.len() as f64
     }
 }
 
@@ -177,8 +180,11 @@ pub struct LandscapePoint {
     pub h1_span: f64,
     /// Training windows whose β1 this rule gets right.
     pub b1_right: usize,
-    /// Share of the hole-free training windows in which it shows a hole.
-    pub false_holes: f64,
+    /// Hole-free training windows in which it shows a hole.
+    pub false_holes: usize,
+    /// Their share of the hole-free training windows (0 if there are none), the quantity
+    /// [`fit`]'s cap bounds.
+    pub false_share: f64,
 }
 
 /// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span): the
@@ -198,7 +204,8 @@ pub fn h1_landscape(samples: &[Sample]) -> Vec<LandscapePoint> {
                 h1_ratio,
                 h1_span,
                 b1_right: prepared.count(&|f, s| c.robust(f, s), 1),
-                false_holes: prepared.false_share(&c),
+                false_holes: prepared.false_holes(&c),
+                false_share: prepared.false_share(&c),
             });
         }
     }
@@ -455,13 +462,14 @@ mod tests {
                 .count();
             let shown = holeless.iter().filter(|s| s.betti(&c)[1] > 0).count();
             assert_eq!(p.b1_right, right, "{p:?}");
-            assert_eq!(p.false_holes, shown as f64 / holeless.len() as f64, "{p:?}");
+            assert_eq!(p.false_holes, shown, "{p:?}");
+            assert_eq!(p.false_share, shown as f64 / holeless.len() as f64, "{p:?}");
         }
         for cap in [0.0, 0.34, 1.0] {
             let fit = fit(&samples, cap).unwrap();
             let best = land
                 .iter()
-                .filter(|p| p.false_holes <= cap + 1e-12)
+                .filter(|p| p.false_share <= cap + 1e-12)
                 .map(|p| p.b1_right)
                 .max()
                 .unwrap();
