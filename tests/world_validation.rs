@@ -710,3 +710,15 @@ fn errors_in_overridden_fields_name_the_override() {
         "{msg}"
     );
 }
+
+#[test]
+fn encounter_midpoints_is_off_unless_asked() {
+    assert!(!check_text("()").expect("valid").mapping.encounter_midpoints);
+    let w = check_text("(mapping: (encounter_midpoints: true))").expect("valid");
+    assert!(w.mapping.encounter_midpoints);
+    assert!(
+        valid_with("mapping.encounter_midpoints", "true")
+            .mapping
+            .encounter_midpoints
+    );
+}

@@ -45,6 +45,9 @@ pub struct LocalParams {
     /// Leave out the encounters that end before the first landmark interval begins
     /// ([`first_landmark_start`]; default: `false`).
     pub after_landmarks: bool,
+    /// Weigh encounters along a time line by the time between their middles
+    /// ([`EncounterGraph::build_timed`]; default: `false`, the paper's gap).
+    pub midpoints: bool,
     /// Subsampling (default: m = 400).
     pub subsample: SubsampleParams,
     /// Smallest number of encounters of a real component (default: `20`).
@@ -75,6 +78,7 @@ impl Default for LocalParams {
             bridging: Bridging::Paper,
             switch_cost: 0.0,
             after_landmarks: false,
+            midpoints: false,
             subsample: SubsampleParams::default(),
             min_component: 20,
             min_share: 0.02,
@@ -96,6 +100,7 @@ impl LocalParams {
         p.bridging = Bridging::Paper;
         p.switch_cost = m.switch_cost;
         p.after_landmarks = m.after_landmarks;
+        p.midpoints = m.encounter_midpoints;
         if m.method == crate::world::MappingMethod::Embedded {
             p.anchored = true;
             p.embedding_rips = Some(super::dense::DenseParams::embedded());
@@ -238,7 +243,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         })
         .cloned()
         .collect();
-    let graph = EncounterGraph::build_switching(&enc, &statics, p.bridging, p.switch_cost);
+    let graph = EncounterGraph::build_timed(&enc, &statics, p.bridging, p.switch_cost, p.midpoints);
     // Whether an encounter involves an agent that was a landmark at the time: its position
     // is the landmark's. Landmark intervals are indexed by agent, so this is O(E · k) for
     // k intervals per agent, not O(E · all intervals).

@@ -134,7 +134,13 @@ pub fn connect(
         .filter(|s| union.meets(s.start, s.end))
         .cloned()
         .collect();
-    let graph = EncounterGraph::build_switching(&enc, &statics, local.bridging, local.switch_cost);
+    let graph = EncounterGraph::build_timed(
+        &enc,
+        &statics,
+        local.bridging,
+        local.switch_cost,
+        local.midpoints,
+    );
     // S_{i,i+1}: static through the whole overlap [start of W_{i+1}, end of W_i].
     let spanning: Vec<_> = statics
         .iter()

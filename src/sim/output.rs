@@ -142,6 +142,9 @@ pub fn world_json(world: &World) -> Value {
     if m.after_landmarks {
         v["mapping"]["after_landmarks"] = json!(true);
     }
+    if m.encounter_midpoints {
+        v["mapping"]["encounter_midpoints"] = json!(true);
+    }
     if s.keep_surplus_landmarks {
         v["swarm"]["keep_surplus_landmarks"] = json!(true);
     }

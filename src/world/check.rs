@@ -625,6 +625,7 @@ impl WorldSpec {
             method,
             switch_cost,
             after_landmarks: m.after_landmarks.unwrap_or(md.after_landmarks),
+            encounter_midpoints: m.encounter_midpoints.unwrap_or(md.encounter_midpoints),
         };
 
         let world = World {

@@ -112,6 +112,7 @@ pub struct MappingSpec {
     pub method: Option<MethodSpec>,
     pub switch_cost: Option<f64>,
     pub after_landmarks: Option<bool>,
+    pub encounter_midpoints: Option<bool>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -271,6 +272,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.method",
     "mapping.switch_cost",
     "mapping.after_landmarks",
+    "mapping.encounter_midpoints",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -391,6 +393,7 @@ impl WorldSpec {
                             "method" => put(&mut s.method, p, v)?,
                             "switch_cost" => put(&mut s.switch_cost, p, v)?,
                             "after_landmarks" => put(&mut s.after_landmarks, p, v)?,
+                            "encounter_midpoints" => put(&mut s.encounter_midpoints, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

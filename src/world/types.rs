@@ -169,6 +169,11 @@ pub struct MappingParams {
     /// records them (`mapping::local::first_landmark_start`; default: `false`, every
     /// encounter of the log, the dispersion's included).
     pub after_landmarks: bool,
+    /// Along an agent's time line, weigh two encounters by the time between their middles
+    /// (the moments of closest approach) instead of the gap between their intervals
+    /// (`mapping::encounter_graph`, "Encounter middles"; default: `false`, the paper's
+    /// weight).
+    pub encounter_midpoints: bool,
 }
 
 impl Default for MappingParams {
@@ -182,6 +187,7 @@ impl Default for MappingParams {
             method: MappingMethod::Paper,
             switch_cost: 0.0,
             after_landmarks: false,
+            encounter_midpoints: false,
         }
     }
 }
