@@ -686,23 +686,28 @@ mod tests {
         }
     }
 
+    /// Asserts that the sparse graph's distances are the clique's, `label` naming the case.
+    fn assert_same_metric(g: &EncounterGraph, want: &[Vec<f64>], label: &str) {
+        for (i, row) in want.iter().enumerate() {
+            let got = g.distances_from(i);
+            for (j, w) in row.iter().enumerate() {
+                assert!(
+                    (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
+                    "{label}: d({i},{j}) sparse {} clique {}",
+                    got[j],
+                    w
+                );
+            }
+        }
+    }
+
     #[test]
     fn sparse_equals_clique() {
         for seed in 0..40 {
             let (enc, statics) = random_log(seed, 40, 6);
             let g = EncounterGraph::build(&enc, &statics, Bridging::Paper);
             let want = clique_metric(&enc, &statics);
-            for (i, row) in want.iter().enumerate() {
-                let got = g.distances_from(i);
-                for (j, w) in row.iter().enumerate() {
-                    assert!(
-                        (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
-                        "seed {seed}: d({i},{j}) sparse {} clique {}",
-                        got[j],
-                        w
-                    );
-                }
-            }
+            assert_same_metric(&g, &want, &format!("seed {seed}"));
             assert!(g.edges() <= 2 * enc.len() + enc.len() * 2);
         }
     }
@@ -716,17 +721,7 @@ mod tests {
             let (enc, statics) = random_log(seed, 40, 6);
             let g = EncounterGraph::build_timed(&enc, &statics, Bridging::Paper, 0.0, true);
             let want = clique_metric_by(&enc, &statics, middle_gap);
-            for (i, row) in want.iter().enumerate() {
-                let got = g.distances_from(i);
-                for (j, w) in row.iter().enumerate() {
-                    assert!(
-                        (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
-                        "seed {seed}: d({i},{j}) sparse {} clique {}",
-                        got[j],
-                        w
-                    );
-                }
-            }
+            assert_same_metric(&g, &want, &format!("seed {seed}, middles"));
         }
     }
 
@@ -790,17 +785,7 @@ mod tests {
             for switch in [0.5, 3.0] {
                 let g = EncounterGraph::build_switching(&enc, &statics, Bridging::Paper, switch);
                 let want = clique_metric_with_switches(&enc, &statics, switch);
-                for (i, row) in want.iter().enumerate() {
-                    let got = g.distances_from(i);
-                    for (j, w) in row.iter().enumerate() {
-                        assert!(
-                            (got[j] - w).abs() <= 1e-9 || (got[j].is_infinite() && w.is_infinite()),
-                            "seed {seed}, switch {switch}: d({i},{j}) sparse {} clique {}",
-                            got[j],
-                            w
-                        );
-                    }
-                }
+                assert_same_metric(&g, &want, &format!("seed {seed}, switch {switch}"));
             }
             // A zero switch cost is the paper's graph itself.
             let paper = EncounterGraph::build(&enc, &statics, Bridging::Paper);
