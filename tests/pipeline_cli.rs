@@ -324,3 +324,87 @@ fn eval_writes_one_row_per_run_and_resumes() {
         .code(2)
         .stderr(contains("agentz"));
 }
+
+/// The shipped model file with every method's thresholds replaced.
+fn model_file(dir: &Path, name: &str, h1_ratio: f64, h1_span: f64) -> std::path::PathBuf {
+    let mut m = json(Path::new("assets/classifier.json"));
+    for method in ["Paper", "Embedded", "Oracle"] {
+        m[method]["classifier"]["h1_ratio"] = serde_json::json!(h1_ratio);
+        m[method]["classifier"]["h1_span"] = serde_json::json!(h1_span);
+    }
+    let path = dir.join(name);
+    fs::write(&path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    path
+}
+
+/// `--model FILE` judges the diagrams with FILE's thresholds (recorded in each window's
+/// map), and a bad model file is refused with its place and exit status 2 before anything
+/// is written.
+#[test]
+fn a_model_file_replaces_the_shipped_thresholds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--no-report", "--quiet", "--out"])
+        .arg(&dir)
+        .assert()
+        .success();
+    // No H1 bar of a finite diagram has death / birth ≥ 10⁹: no hole anywhere.
+    let strict = model_file(tmp.path(), "strict.json", 1e9, 0.0);
+    swarmmap()
+        .arg("map")
+        .arg(&dir)
+        .arg("--model")
+        .arg(&strict)
+        .assert()
+        .success();
+    let s = json(&dir.join("summary.json"));
+    for w in s["windows"].as_array().unwrap() {
+        assert_eq!(w["betti"][1], 0, "{w}");
+    }
+    assert_eq!(s["global"]["betti"][1], 0, "{}", s["global"]);
+    let w1 = json(&dir.join("maps/window_1.json"));
+    assert_eq!(w1["classifier"]["h1_ratio"], 1e9);
+    // The most lenient rule keeps every H1 bar: at least as many holes as the shipped one.
+    let lenient = model_file(tmp.path(), "lenient.json", 1.0, 0.0);
+    swarmmap()
+        .arg("map")
+        .arg(&dir)
+        .arg("--model")
+        .arg(&lenient)
+        .assert()
+        .success();
+    let s = json(&dir.join("summary.json"));
+    let holes: u64 = s["windows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["betti"][1].as_u64().unwrap())
+        .sum();
+    assert!(holes >= 1, "{s}");
+    assert_eq!(
+        json(&dir.join("maps/window_1.json"))["classifier"]["h1_ratio"],
+        1.0
+    );
+    // Bad model files: the summary stays as the last good map wrote it.
+    let before_bad = fs::read(dir.join("summary.json")).unwrap();
+    let broken = tmp.path().join("broken.json");
+    fs::write(&broken, "{\n  \"Paper\": 1\n}\n").unwrap();
+    let out_of_range = model_file(tmp.path(), "range.json", 0.5, 0.0);
+    let missing = tmp.path().join("missing.json");
+    for (file, says) in [
+        (&broken, "broken.json:2:"),
+        (&out_of_range, "out of range"),
+        (&missing, "cannot read the model file"),
+    ] {
+        swarmmap()
+            .arg("map")
+            .arg(&dir)
+            .arg("--model")
+            .arg(file)
+            .assert()
+            .code(2)
+            .stderr(contains(says));
+        assert_eq!(fs::read(dir.join("summary.json")).unwrap(), before_bad);
+    }
+}

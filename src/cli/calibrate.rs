@@ -162,7 +162,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         Ok(text) => serde_json::from_str(&text)
             .with_context(|| format!("{} is not a model file", args.out.display()))
             .map_err(input)?,
-        Err(_) => Models::shipped(),
+        Err(_) => Models::active(),
     };
     let mut by_method: Vec<Training> = Vec::new();
     for r in results {
@@ -282,7 +282,8 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     write_atomic(&args.out, text.as_bytes())
         .with_context(|| format!("writing {}", args.out.display()))?;
     println!(
-        "model written to {} (rebuild swarmmap to use it as the default)",
+        "model written to {0} (use it with `--model {0}`, or rebuild swarmmap to make it the \
+         default)",
         args.out.display()
     );
     Ok(())

@@ -66,6 +66,11 @@ pub fn progress_bar(quiet: bool, label: &str) -> Option<indicatif::ProgressBar> 
     about = "Topological maps from the encounters of a robot swarm"
 )]
 struct Cli {
+    /// Judge persistence diagrams with the models of FILE (written by `swarmmap calibrate
+    /// --out FILE`) instead of the shipped assets/classifier.json, for map, run and eval
+    /// (and as calibrate's starting point when its --out file does not exist yet).
+    #[arg(long, global = true, value_name = "FILE")]
+    model: Option<std::path::PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
@@ -95,6 +100,19 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Err(e) = swarmmap::io::install_interrupt_handler() {
         eprintln!("warning: Ctrl-C will not clean up partial files: {e}");
+    }
+    if let Some(path) = &cli.model {
+        match swarmmap::mapping::classify::Models::load(path) {
+            Ok(models) => {
+                // The first and only call, before anything has mapped.
+                let first = swarmmap::mapping::classify::Models::use_instead(models);
+                debug_assert!(first);
+            }
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                return ExitCode::from(2);
+            }
+        }
     }
     let result: Result<(), Failure> = match cli.command {
         Command::Check(args) => check::run(&args),

@@ -60,10 +60,69 @@ pub struct Model {
 /// The text of the shipped models.
 pub const SHIPPED: &str = include_str!("../../assets/classifier.json");
 
+/// The models this process maps with, when not the shipped ones ([`Models::use_instead`]).
+static ACTIVE: std::sync::OnceLock<Models> = std::sync::OnceLock::new();
+
 impl Models {
     /// The shipped models.
     pub fn shipped() -> Self {
         serde_json::from_str(SHIPPED).expect("assets/classifier.json is a valid model file")
+    }
+
+    /// The models every later mapping in this process uses: those given to
+    /// [`Models::use_instead`] (the command line's `--model FILE`), else the shipped ones.
+    pub fn active() -> Self {
+        ACTIVE.get().cloned().unwrap_or_else(Self::shipped)
+    }
+
+    /// Maps with `models` instead of the shipped ones for the rest of the process. Call it
+    /// once, before any mapping starts; a second call is refused (returns `false`).
+    pub fn use_instead(models: Models) -> bool {
+        ACTIVE.set(models).is_ok()
+    }
+
+    /// Reads a model file written by `swarmmap calibrate`. The error names the file, the
+    /// line and column of a JSON fault, and what a model file holds.
+    pub fn load(path: &std::path::Path) -> anyhow::Result<Self> {
+        use anyhow::Context;
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read the model file {}", path.display()))?;
+        let models: Models = serde_json::from_str(&text).map_err(|e| {
+            anyhow::anyhow!(
+                "{}:{}:{}: not a model file: {e}; a model file is what `swarmmap calibrate \
+                 --out FILE` writes: an object with \"Paper\", \"Embedded\" and \"Oracle\" \
+                 entries, each {{\"classifier\": {{\"h0_ratio\", \"h1_ratio\", \"h1_span\"}}, \
+                 \"fitted_on\"}} (see assets/classifier.json)",
+                path.display(),
+                e.line(),
+                e.column()
+            )
+        })?;
+        for (name, m) in [
+            ("Paper", &models.paper),
+            ("Embedded", &models.embedded),
+            ("Oracle", &models.oracle),
+        ] {
+            let c = m.classifier;
+            let ok = c.h0_ratio.is_finite()
+                && c.h0_ratio > 0.0
+                && c.h1_ratio.is_finite()
+                && c.h1_ratio >= 1.0
+                && c.h1_span.is_finite()
+                && c.h1_span >= 0.0;
+            if !ok {
+                anyhow::bail!(
+                    "{}: the {name} model's thresholds (h0_ratio {}, h1_ratio {}, h1_span {}) \
+                     are out of range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, \
+                     all finite",
+                    path.display(),
+                    c.h0_ratio,
+                    c.h1_ratio,
+                    c.h1_span
+                );
+            }
+        }
+        Ok(models)
     }
 
     /// The model of a method.

@@ -96,7 +96,7 @@ impl LocalParams {
     pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
-        p.classifier = super::classify::Models::shipped().get(m.method).classifier;
+        p.classifier = super::classify::Models::active().get(m.method).classifier;
         p.bridging = Bridging::Paper;
         p.switch_cost = m.switch_cost;
         p.after_landmarks = m.after_landmarks;

@@ -134,7 +134,7 @@ pub fn true_positions(map: &LocalMap, log: &EncounterLog) -> Option<Vec<[f64; 2]
 
 /// (β0, β1) of the oracle: [`oracle_features`] judged by the shipped oracle model.
 fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
-    let classifier = super::classify::Models::shipped().oracle.classifier;
+    let classifier = super::classify::Models::active().oracle.classifier;
     let mut betti = [0, 0];
     for features in oracle_features(map, truth) {
         let b = classifier.betti(&features);
