@@ -101,29 +101,17 @@ pub fn main() -> ExitCode {
     if let Err(e) = swarmmap::io::install_interrupt_handler() {
         eprintln!("warning: Ctrl-C will not clean up partial files: {e}");
     }
-    if let Some(path) = &cli.model {
-        match swarmmap::mapping::classify::Models::load(path) {
-            Ok(models) => {
-                // The first and only call, before anything has mapped.
-                let first = swarmmap::mapping::classify::Models::use_instead(models);
-                debug_assert!(first);
-            }
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                return ExitCode::from(2);
-            }
-        }
-    }
-    let result: Result<(), Failure> = match cli.command {
-        Command::Check(args) => check::run(&args),
-        Command::Simulate(args) => simulate::run(&args),
-        Command::Map(args) => map::run(&args),
-        Command::Run(args) => run::run(&args),
-        Command::Eval(args) => eval::run(&args),
-        Command::Calibrate(args) => calibrate::run(&args),
-        Command::Persistence(a) => persistence::run(a),
-        Command::Report(args) => report::run(&args),
-    };
+    let result: Result<(), Failure> =
+        use_model(cli.model.as_deref()).and_then(|()| match cli.command {
+            Command::Check(args) => check::run(&args),
+            Command::Simulate(args) => simulate::run(&args),
+            Command::Map(args) => map::run(&args),
+            Command::Run(args) => run::run(&args),
+            Command::Eval(args) => eval::run(&args),
+            Command::Calibrate(args) => calibrate::run(&args),
+            Command::Persistence(a) => persistence::run(a),
+            Command::Report(args) => report::run(&args),
+        });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
@@ -135,6 +123,18 @@ pub fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// `--model FILE`: every later mapping in this process judges with FILE's models; a bad file
+/// is an input error (status 2), reported before any command runs.
+fn use_model(path: Option<&std::path::Path>) -> Result<(), Failure> {
+    use swarmmap::mapping::classify::Models;
+    if let Some(path) = path {
+        let first = Models::use_instead(Models::load(path).map_err(input)?);
+        // Called once, before anything has mapped.
+        debug_assert!(first);
+    }
+    Ok(())
 }
 
 /// Restores the default action of SIGPIPE, which Rust's runtime sets to "ignore": a command
