@@ -261,6 +261,8 @@ fn meaningless_numbers_are_rejected_everywhere() {
         ("mapping.cluster_cutoff", "0.0", "must be > 0"),
         ("mapping.subsample", "0", "must be at least 1"),
         ("mapping.neighbours", "-1", "must be at least 0"),
+        ("mapping.rips_points", "49", "must be at least 50"),
+        ("mapping.rips_points", "100001", "must be at most 100000"),
         ("mapping.switch_cost", "-1.0", "must be ≥ 0 seconds"),
         ("mapping.switch_cost", "inf", "must be a finite number"),
         ("swarm.agents", "-5", "must be at least 1"),
@@ -720,5 +722,16 @@ fn encounter_midpoints_is_off_unless_asked() {
         valid_with("mapping.encounter_midpoints", "true")
             .mapping
             .encounter_midpoints
+    );
+}
+
+#[test]
+fn rips_points_defaults_to_1200_and_can_be_set() {
+    assert_eq!(check_text("()").expect("valid").mapping.rips_points, 1200);
+    let w = check_text("(mapping: (rips_points: 2400))").expect("valid");
+    assert_eq!(w.mapping.rips_points, 2400);
+    assert_eq!(
+        valid_with("mapping.rips_points", "600").mapping.rips_points,
+        600
     );
 }

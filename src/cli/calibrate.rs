@@ -143,7 +143,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                             format!("{} seed {seed}: the log has no truth columns", world.name)
                         })?;
                         Ok(Sample {
-                            components: oracle_features(&m, &positions),
+                            components: oracle_features(&m, &positions, world.mapping.rips_points),
                             truth,
                         })
                     })

@@ -175,9 +175,14 @@ mod tests {
             };
             let error = |p: &LocalParams| {
                 let map = local_map(&log, &w, p);
-                crate::mapping::pipeline::fidelity(&map, &log, 72f64.sqrt())
-                    .procrustes
-                    .expect("truth columns")
+                crate::mapping::pipeline::fidelity(
+                    &map,
+                    &log,
+                    72f64.sqrt(),
+                    crate::mapping::dense::EMBEDDED_POINTS,
+                )
+                .procrustes
+                .expect("truth columns")
             };
             p.bridge = true;
             let bridged = error(&p);

@@ -37,11 +37,17 @@ impl DenseParams {
     /// agents' encounters between them, which opens false holes in empty arenas; and with
     /// 300 points the sampling scale σ is too coarse for 1–1.5 m obstacles.
     pub fn embedded() -> Self {
+        Self::embedded_with(EMBEDDED_POINTS)
+    }
+
+    /// [`Self::embedded`] with `m` points instead of [`EMBEDDED_POINTS`] (a world's
+    /// `mapping.rips_points`).
+    pub fn embedded_with(m: usize) -> Self {
         Self {
             dims: 2,
             k: 10,
             keep: 1.0,
-            m: EMBEDDED_POINTS,
+            m,
         }
     }
 }

@@ -103,7 +103,7 @@ impl LocalParams {
         p.midpoints = m.encounter_midpoints;
         if m.method == crate::world::MappingMethod::Embedded {
             p.anchored = true;
-            p.embedding_rips = Some(super::dense::DenseParams::embedded());
+            p.embedding_rips = Some(super::dense::DenseParams::embedded_with(m.rips_points));
             p.bridge = true;
         }
         p
@@ -583,5 +583,24 @@ mod tests {
                 c.events.len()
             );
         }
+    }
+
+    #[test]
+    fn rips_points_sets_the_embedded_methods_planar_points() {
+        let mut m = crate::world::MappingParams {
+            method: crate::world::MappingMethod::Embedded,
+            ..Default::default()
+        };
+        let shipped = LocalParams::from_mapping(&m)
+            .embedding_rips
+            .expect("Embedded");
+        assert_eq!(shipped.m, super::super::dense::EMBEDDED_POINTS);
+        m.rips_points = 2400;
+        let p = LocalParams::from_mapping(&m)
+            .embedding_rips
+            .expect("Embedded");
+        assert_eq!(p, super::super::dense::DenseParams::embedded_with(2400));
+        m.method = crate::world::MappingMethod::Paper;
+        assert!(LocalParams::from_mapping(&m).embedding_rips.is_none());
     }
 }

@@ -56,7 +56,7 @@ pub fn true_position(t: &[f64; 4]) -> [f64; 2] {
 }
 
 /// Geometric fidelity of a local map against the log's truth columns (none without them).
-pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
+pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64, rips_points: usize) -> Fidelity {
     let Some(truth) = true_positions(map, log) else {
         return Fidelity::default();
     };
@@ -97,13 +97,17 @@ pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64) -> Fidelity {
     Fidelity {
         spearman: rho.is_finite().then_some(rho),
         procrustes,
-        oracle: Some(oracle_betti(map, &truth)),
+        oracle: Some(oracle_betti(map, &truth, rips_points)),
     }
 }
 
 /// Per real component of `map`, the features of the `Embedded` topology stage run on the
 /// true positions `truth` (one per event of `map`) of its events; see [`Fidelity::oracle`].
-pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::classify::Feature>> {
+pub fn oracle_features(
+    map: &LocalMap,
+    truth: &[[f64; 2]],
+    rips_points: usize,
+) -> Vec<Vec<super::classify::Feature>> {
     let mapped: usize = map.components.iter().map(|c| c.events.len()).sum();
     map.components
         .iter()
@@ -115,7 +119,7 @@ pub fn oracle_features(map: &LocalMap, truth: &[[f64; 2]]) -> Vec<Vec<super::cla
                 .collect();
             let (diagram, _) = super::dense::dense_rips(
                 &coords,
-                &super::dense::DenseParams::embedded()
+                &super::dense::DenseParams::embedded_with(rips_points)
                     .for_share(c.events.len() as f64 / mapped as f64),
                 &RipsOptions::default(),
             )?;
@@ -133,10 +137,10 @@ pub fn true_positions(map: &LocalMap, log: &EncounterLog) -> Option<Vec<[f64; 2]
 }
 
 /// (β0, β1) of the oracle: [`oracle_features`] judged by the shipped oracle model.
-fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]]) -> [usize; 2] {
+fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]], rips_points: usize) -> [usize; 2] {
     let classifier = super::classify::Models::active().oracle.classifier;
     let mut betti = [0, 0];
-    for features in oracle_features(map, truth) {
+    for features in oracle_features(map, truth, rips_points) {
         let b = classifier.betti(&features);
         betti[0] += b[0];
         betti[1] += b[1];
@@ -178,7 +182,14 @@ pub fn summarise_window(
             .zip(band)
             .map(|((_, fs), (a, b))| fs.betti_in_band(a, b)),
         domain: band.map(|(a, b)| [a, b]),
-        fidelity: fidelity(m, log, diagonal),
+        fidelity: fidelity(
+            m,
+            log,
+            diagonal,
+            truth.map_or(super::dense::EMBEDDED_POINTS, |(w, _)| {
+                w.mapping.rips_points
+            }),
+        ),
     }
 }
 
@@ -226,9 +237,15 @@ mod oracle_tests {
     #[test]
     fn oracle_sees_the_hole_of_an_annulus_and_none_in_a_disc() {
         let (map, truth) = map_over(|x, y| (1.0..=2.0).contains(&x.hypot(y)));
-        assert_eq!(oracle_betti(&map, &truth), [1, 1]);
+        assert_eq!(
+            oracle_betti(&map, &truth, super::super::dense::EMBEDDED_POINTS),
+            [1, 1]
+        );
         let (map, truth) = map_over(|x, y| x.hypot(y) <= 2.0);
-        assert_eq!(oracle_betti(&map, &truth), [1, 0]);
+        assert_eq!(
+            oracle_betti(&map, &truth, super::super::dense::EMBEDDED_POINTS),
+            [1, 0]
+        );
     }
 
     #[test]
@@ -244,10 +261,16 @@ mod oracle_tests {
                 truth: Some([p[0], p[1], p[0], p[1]]),
             });
         }
-        assert_eq!(fidelity(&map, &log, 1.0).oracle, Some([1, 1]));
+        assert_eq!(
+            fidelity(&map, &log, 1.0, super::super::dense::EMBEDDED_POINTS).oracle,
+            Some([1, 1])
+        );
         for e in &mut log.encounters {
             e.truth = None;
         }
-        assert_eq!(fidelity(&map, &log, 1.0).oracle, None);
+        assert_eq!(
+            fidelity(&map, &log, 1.0, super::super::dense::EMBEDDED_POINTS).oracle,
+            None
+        );
     }
 }

@@ -612,6 +612,13 @@ impl WorldSpec {
             "seconds",
             "use 0 (the paper's metric) or a positive cost per change of agent, e.g. detection_radius / speed",
         )?;
+        let rips_points = ctx.count(
+            "mapping.rips_points",
+            m.rips_points.unwrap_or(md.rips_points as i64),
+            crate::mapping::dense::MIN_COMPONENT_POINTS as i64,
+            100_000,
+            "use 50 to 100000 points, e.g. 1200 (the Embedded method's default)",
+        )?;
         let method = match m.method {
             None | Some(MethodSpec::Paper) => MappingMethod::Paper,
             Some(MethodSpec::Embedded) => MappingMethod::Embedded,
@@ -626,6 +633,7 @@ impl WorldSpec {
             switch_cost,
             after_landmarks: m.after_landmarks.unwrap_or(md.after_landmarks),
             encounter_midpoints: m.encounter_midpoints.unwrap_or(md.encounter_midpoints),
+            rips_points,
         };
 
         let world = World {

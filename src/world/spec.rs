@@ -113,6 +113,7 @@ pub struct MappingSpec {
     pub switch_cost: Option<f64>,
     pub after_landmarks: Option<bool>,
     pub encounter_midpoints: Option<bool>,
+    pub rips_points: Option<i64>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -273,6 +274,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.switch_cost",
     "mapping.after_landmarks",
     "mapping.encounter_midpoints",
+    "mapping.rips_points",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -394,6 +396,7 @@ impl WorldSpec {
                             "switch_cost" => put(&mut s.switch_cost, p, v)?,
                             "after_landmarks" => put(&mut s.after_landmarks, p, v)?,
                             "encounter_midpoints" => put(&mut s.encounter_midpoints, p, v)?,
+                            "rips_points" => put(&mut s.rips_points, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

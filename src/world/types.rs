@@ -174,6 +174,10 @@ pub struct MappingParams {
     /// (`mapping::encounter_graph`, "Encounter middles"; default: `false`, the paper's
     /// weight).
     pub encounter_midpoints: bool,
+    /// Points of the planar Vietoris–Rips complex of the `Embedded` method and of the
+    /// truth-position oracle, MaxMin-picked from a window's events and shared among its
+    /// components (`mapping::dense`; default: `1200`).
+    pub rips_points: usize,
 }
 
 impl Default for MappingParams {
@@ -188,6 +192,7 @@ impl Default for MappingParams {
             switch_cost: 0.0,
             after_landmarks: false,
             encounter_midpoints: false,
+            rips_points: crate::mapping::dense::EMBEDDED_POINTS,
         }
     }
 }
