@@ -1393,6 +1393,7 @@ fn the_number_scanner_finds_the_fields_of_empty_ron() {
             "mapping.windows",
             "mapping.cluster_cutoff",
             "mapping.switch_cost",
+            "mapping.rips_points",
             "seed",
         ]
     );
