@@ -28,8 +28,32 @@ fn check_prints_a_summary_of_each_scenario() {
                 "windows    {windows} with overlap Δt = 300 s"
             )))
             .stdout(predicate::str::contains(format!("W{windows} ")))
-            .stdout(predicate::str::contains(format!("W{} ", windows + 1)).not());
+            .stdout(predicate::str::contains(format!("W{} ", windows + 1)).not())
+            .stdout(predicate::str::contains(
+                "mapping    Embedded method, switch cost 1 s, c = 35, m = 400, k = 5; \
+                 encounters after the first landmark; weights between encounter middles; \
+                 2400 planar Rips points",
+            ));
     }
+}
+
+#[test]
+fn check_summarises_the_paper_mapping_without_rips_points() {
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario1.ron",
+            "--set",
+            "mapping.method=Paper",
+        ])
+        .args(["--set", "mapping.after_landmarks=false"])
+        .args(["--set", "mapping.encounter_midpoints=false"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "mapping    Paper method, switch cost 1 s, c = 35, m = 400, k = 5; \
+             every encounter; the paper's interval-gap weights\n",
+        ));
 }
 
 #[test]

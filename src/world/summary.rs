@@ -146,6 +146,31 @@ impl World {
                 x1
             );
         }
+        let m = &self.mapping;
+        let _ = writeln!(
+            s,
+            "mapping    {:?} method, switch cost {} s, c = {}, m = {}, k = {}; {}; {}{}",
+            m.method,
+            m.switch_cost,
+            m.cluster_cutoff,
+            m.subsample,
+            m.neighbours,
+            if m.after_landmarks {
+                "encounters after the first landmark"
+            } else {
+                "every encounter"
+            },
+            if m.encounter_midpoints {
+                "weights between encounter middles"
+            } else {
+                "the paper's interval-gap weights"
+            },
+            if m.method == super::MappingMethod::Embedded {
+                format!("; {} planar Rips points", m.rips_points)
+            } else {
+                String::new()
+            }
+        );
         let _ = write!(s, "seed       {}", self.seed);
         s
     }
