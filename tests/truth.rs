@@ -270,6 +270,7 @@ fn hand_made_worlds_at_three_resolutions() {
                     case.name
                 );
                 assert_eq!(fs.components_in_band(x0, x1), want[0]);
+                assert_eq!(fs.holes_in_band(x0, x1).len(), want[1]);
                 assert_eq!(fs.label_band(x0, x1).count(), want[0]);
             }
             assert_eq!(euler_global(&fs), betti_chi(fs.global_betti()));

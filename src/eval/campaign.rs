@@ -192,6 +192,10 @@ pub struct Score {
     /// oracles equal the truth.
     pub oracle: usize,
     pub oracle_ok: usize,
+    /// Windows with a hole check (`holes`), and how many of them found exactly the
+    /// truth's obstacles ([`crate::eval::HoleCheck::right`]).
+    pub hole_checks: usize,
+    pub holes_ok: usize,
     pub connections: usize,
     pub connections_ok: usize,
     pub global_ok: bool,
@@ -201,6 +205,9 @@ pub struct Score {
     pub window_betti: String,
     pub window_truth: String,
     pub window_oracle: String,
+    /// Per window with a hole check: obstacles found / obstacles in the truth, and `+k`
+    /// for k robust holes that encircle no obstacle (or one already found).
+    pub window_holes: String,
     pub global: String,
     pub global_truth: String,
 }
@@ -212,7 +219,7 @@ fn pair(v: &serde_json::Value) -> Option<[u64; 2]> {
 /// Scores a stored summary.
 pub fn score(summary: &serde_json::Value) -> Score {
     let mut s = Score::default();
-    let (mut est, mut tru, mut ora) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut est, mut tru, mut ora, mut hol) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for w in summary["windows"].as_array().into_iter().flatten() {
         let (Some(b), t) = (pair(&w["betti"]), pair(&w["truth"])) else {
             continue;
@@ -232,6 +239,16 @@ pub fn score(summary: &serde_json::Value) -> Score {
                 ora.push(format!("{}:{}", o[0], o[1]));
                 s.oracle += 1;
                 s.oracle_ok += usize::from(o == t);
+            }
+            if let Ok(h) = serde_json::from_value::<crate::eval::HoleCheck>(w["holes"].clone()) {
+                s.hole_checks += 1;
+                s.holes_ok += usize::from(h.right());
+                let extra = h.spurious();
+                hol.push(if extra > 0 {
+                    format!("{}/{}+{extra}", h.matched(), h.truth.len())
+                } else {
+                    format!("{}/{}", h.matched(), h.truth.len())
+                });
             }
         }
         if let Some(x) = w["fidelity"]["spearman"].as_f64() {
@@ -260,6 +277,7 @@ pub fn score(summary: &serde_json::Value) -> Score {
     s.window_betti = est.join(" ");
     s.window_truth = tru.join(" ");
     s.window_oracle = ora.join(" ");
+    s.window_holes = hol.join(" ");
     s
 }
 
@@ -276,12 +294,12 @@ pub fn csv(records: &[RunRecord]) -> String {
     let mut out = String::from(
         "world,params,seed,windows,windows_ok,b0_ok,b1_ok,holeless,holeless_ok,oracle_ok,\
          connections,connections_ok,global,global_truth,global_ok,spearman,procrustes,seconds,\
-         window_betti,window_truth,window_oracle,error\n",
+         window_betti,window_truth,window_oracle,holes_ok,window_holes,error\n",
     );
     for r in records {
         let s = r.summary.as_ref().map(score).unwrap_or_default();
         out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{},{},{}\n",
             r.world,
             quote(&r.params),
             r.seed,
@@ -303,6 +321,8 @@ pub fn csv(records: &[RunRecord]) -> String {
             s.window_betti,
             s.window_truth,
             s.window_oracle,
+            s.holes_ok,
+            s.window_holes,
             quote(r.error.as_deref().unwrap_or("")),
         ));
     }
@@ -327,7 +347,7 @@ pub fn table(records: &[RunRecord]) -> String {
             .push(r);
     }
     let mut out = String::from(
-        "world        params                          runs fail  windows ok  β0 ok   β1 ok   no-hole ok  oracle ok  conn ok   global ok  spearman  procr.  s/run\n",
+        "world        params                          runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  spearman  procr.  s/run\n",
     );
     let pct = |a: usize, b: usize| {
         if b == 0 {
@@ -349,7 +369,7 @@ pub fn table(records: &[RunRecord]) -> String {
         let pr: Vec<f64> = scores.iter().flat_map(|s| s.procrustes.clone()).collect();
         let times: Vec<f64> = scores.iter().map(|s| s.time).collect();
         out.push_str(&format!(
-            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>10}  {:>9}  {:>7}  {:>9}  {:>8.2}  {:>6.3}  {:>5.1}\n",
+            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>8.2}  {:>6.3}  {:>5.1}\n",
             world,
             if params.is_empty() { "(defaults)" } else { params },
             rs.len(),
@@ -357,6 +377,7 @@ pub fn table(records: &[RunRecord]) -> String {
             pct(wok, w),
             pct(sum(|s| s.b0_ok), w),
             pct(sum(|s| s.b1_ok), w),
+            pct(sum(|s| s.holes_ok), sum(|s| s.hole_checks)),
             pct(sum(|s| s.holeless_ok), sum(|s| s.holeless)),
             pct(sum(|s| s.oracle_ok), sum(|s| s.oracle)),
             pct(sum(|s| s.connections_ok), sum(|s| s.connections)),
@@ -401,7 +422,8 @@ mod tests {
         let v = serde_json::json!({
             "windows": [
                 {"betti": [1, 0], "truth": [1, 0], "fidelity": {"spearman": 0.5, "procrustes": null}},
-                {"betti": [1, 1], "truth": [2, 1], "fidelity": {"oracle": [2, 1]}},
+                {"betti": [1, 1], "truth": [2, 1], "fidelity": {"oracle": [2, 1]},
+                 "holes": {"truth": [[1.0, 2.0]], "found": [null]}},
             ],
             "connections": [{"count": 2, "truth": 2}, {"count": 1, "truth": 2}],
             "global": {"betti": [1, 1], "truth": [1, 1]},
@@ -416,5 +438,7 @@ mod tests {
         assert_eq!(s.window_betti, "1:0 1:1");
         assert_eq!((s.oracle, s.oracle_ok), (1, 1));
         assert_eq!(s.window_oracle, "2:1");
+        assert_eq!((s.hole_checks, s.holes_ok), (1, 0));
+        assert_eq!(s.window_holes, "0/1+1");
     }
 }

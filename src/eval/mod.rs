@@ -5,13 +5,18 @@
 //!   numbers, from a cached raster of the world ([`FreeSpace`]).
 //! - [`fidelity`]: rank correlation of the encounter metric with true distances
 //!   ([`spearman`]) and the Procrustes error of the embedding ([`procrustes_error`]).
+//! - [`holes`]: which obstacles of the truth a window's robust holes encircle.
 
 //! - [`campaign`]: `swarmmap eval`, many worlds × parameters × seeds in parallel.
 
 pub mod calibrate;
 pub mod campaign;
 pub mod fidelity;
+pub mod holes;
 pub mod truth;
 
 pub use fidelity::{Procrustes, Similarity, procrustes, procrustes_error, spearman};
-pub use truth::{BandComponents, DEFAULT_RESOLUTION, FreeSpace, TruthError, overlap, window_band};
+pub use holes::HoleCheck;
+pub use truth::{
+    BandComponents, DEFAULT_RESOLUTION, FreeSpace, TrueHole, TruthError, overlap, window_band,
+};

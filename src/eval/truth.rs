@@ -121,6 +121,24 @@ pub struct FreeSpace {
     holes: usize,
 }
 
+/// One hole of the reachable free space inside a band ([`FreeSpace::holes_in_band`]): an
+/// obstacle (grown by the body radius, with any pocket no agent can enter) that the swarm
+/// can walk round inside the band.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrueHole {
+    /// The hole's cell centre nearest the mean of its cells (metres): a point to name it by,
+    /// inside it for every convex or L-shaped obstacle.
+    pub inside: [f64; 2],
+    /// Its area, m².
+    pub area: f64,
+    /// Up to [`HOLE_SAMPLES`] of its cell centres, spread evenly over its cells in
+    /// column-major order: a cycle encircles the hole when it encircles most of them.
+    pub samples: Vec<[f64; 2]>,
+}
+
+/// How many cell centres of a hole [`TrueHole::samples`] keeps.
+pub const HOLE_SAMPLES: usize = 32;
+
 /// The components of R ∩ band, labelled; built by [`FreeSpace::label_band`].
 #[derive(Debug, Clone)]
 pub struct BandComponents {
@@ -354,6 +372,52 @@ impl FreeSpace {
                 }
             }
         }
+    }
+
+    /// The holes of R ∩ [x0, x1] × [0, height], the ones [`FreeSpace::betti_in_band`]
+    /// counts as β1 (same raster, same rule), in order of their first cell (column-major),
+    /// for telling which of them a map found ([`crate::eval::holes`]).
+    pub fn holes_in_band(&self, x0: f64, x1: f64) -> Vec<TrueHole> {
+        let Some((c0, c1)) = self.columns(x0, x1) else {
+            return Vec::new();
+        };
+        let ny = self.ny;
+        let slice = &self.reach[c0 * ny..(c1 + 1) * ny];
+        let h = self.resolution;
+        let centre = |k: usize| {
+            [
+                ((c0 + k / ny) as f64 + 0.5) * h,
+                ((k % ny) as f64 + 0.5) * h,
+            ]
+        };
+        hole_cells_8(slice, c1 - c0 + 1, ny)
+            .into_iter()
+            .map(|cells| {
+                let n = cells.len();
+                let (mut sx, mut sy) = (0.0, 0.0);
+                for &k in &cells {
+                    let p = centre(k);
+                    sx += p[0];
+                    sy += p[1];
+                }
+                let mean = [sx / n as f64, sy / n as f64];
+                let off = |p: [f64; 2]| (p[0] - mean[0]).hypot(p[1] - mean[1]);
+                let inside = cells
+                    .iter()
+                    .map(|&k| centre(k))
+                    .min_by(|a, b| off(*a).total_cmp(&off(*b)))
+                    .expect("a hole has a cell");
+                let m = n.min(HOLE_SAMPLES);
+                let samples = (0..m)
+                    .map(|i| centre(cells[i * n / m + n / (2 * m)]))
+                    .collect();
+                TrueHole {
+                    inside,
+                    area: n as f64 * h * h,
+                    samples,
+                }
+            })
+            .collect()
     }
 
     /// The columns whose centres lie in [x0, x1], or `None` if there are none.
@@ -599,12 +663,20 @@ fn label_4(mask: &[bool], ncols: usize, ny: usize) -> (Vec<u32>, usize) {
 /// `ncols × ny`) when the grid is padded by a ring of complement cells: components that
 /// reach the first or last column or row belong to the unbounded outside.
 fn count_holes_8(mask: &[bool], ncols: usize, ny: usize) -> usize {
+    holes_8(mask, ncols, ny, |_, _| ())
+}
+
+/// Floods every bounded 8-connected component of the complement of `mask` (the holes
+/// [`count_holes_8`] counts), calling `cell(h, k)` for each cell `k` of hole `h`, holes
+/// numbered `0..` in order of their first cell (column-major); returns their number.
+fn holes_8(mask: &[bool], ncols: usize, ny: usize, mut cell: impl FnMut(usize, usize)) -> usize {
     let mut seen = vec![false; mask.len()];
     let mut stack = Vec::new();
-    let mut flood = |start: usize, seen: &mut Vec<bool>| {
+    let mut flood = |start: usize, seen: &mut Vec<bool>, cell: &mut dyn FnMut(usize)| {
         seen[start] = true;
         stack.push(start);
         while let Some(k) = stack.pop() {
+            cell(k);
             let (i, j) = (k / ny, k % ny);
             let (ilo, ihi) = (i.saturating_sub(1), (i + 1).min(ncols - 1));
             let (jlo, jhi) = (j.saturating_sub(1), (j + 1).min(ny - 1));
@@ -624,17 +696,32 @@ fn count_holes_8(mask: &[bool], ncols: usize, ny: usize) -> usize {
         .chain((0..ncols).flat_map(|i| [i * ny, i * ny + ny - 1]));
     for k in boundary {
         if !mask[k] && !seen[k] {
-            flood(k, &mut seen);
+            flood(k, &mut seen, &mut |_| ());
         }
     }
     let mut holes = 0;
     for k in 0..mask.len() {
         if !mask[k] && !seen[k] {
-            flood(k, &mut seen);
+            flood(k, &mut seen, &mut |q| cell(holes, q));
             holes += 1;
         }
     }
     holes
+}
+
+/// The cells of each hole of [`holes_8`], each list sorted (column-major order).
+fn hole_cells_8(mask: &[bool], ncols: usize, ny: usize) -> Vec<Vec<usize>> {
+    let mut cells: Vec<Vec<usize>> = Vec::new();
+    holes_8(mask, ncols, ny, |h, k| {
+        if cells.len() <= h {
+            cells.resize_with(h + 1, Vec::new);
+        }
+        cells[h].push(k);
+    });
+    for c in &mut cells {
+        c.sort_unstable();
+    }
+    cells
 }
 
 #[cfg(test)]

@@ -44,6 +44,10 @@ pub struct WindowSummary {
     /// The domain D_i as `[x_min, x_max]`, metres, when the leader's track is known.
     pub domain: Option<[f64; 2]>,
     pub fidelity: Fidelity,
+    /// The robust holes matched to the obstacles of the truth (with a world and the log's
+    /// truth columns; [`crate::eval::holes`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holes: Option<crate::eval::HoleCheck>,
 }
 
 /// The connections between two consecutive windows in `summary.json`.
@@ -296,6 +300,26 @@ fn betti_cell(b: [usize; 2], t: Option<[usize; 2]>) -> String {
     }
 }
 
+/// What a window's hole check found wrong, for the run table: the obstacles of the truth
+/// no robust hole encircles, and the robust holes that are not obstacles.
+fn hole_note(h: &crate::eval::HoleCheck) -> String {
+    let mut parts = Vec::new();
+    let missed: Vec<String> = h
+        .missed()
+        .iter()
+        .map(|&t| format!("({:.1}, {:.1})", h.truth[t][0], h.truth[t][1]))
+        .collect();
+    if !missed.is_empty() {
+        parts.push(format!("missed the obstacle at {}", missed.join(", ")));
+    }
+    match h.spurious() {
+        0 => {}
+        1 => parts.push("1 hole encircles no obstacle of its own".into()),
+        n => parts.push(format!("{n} holes encircle no obstacle of their own")),
+    }
+    parts.join("; ")
+}
+
 fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or_else(|| "-".to_string(), |x| format!("{x:.digits$}"))
 }
@@ -322,6 +346,9 @@ impl Summary {
                 opt(w.fidelity.spearman, 2),
                 opt(w.fidelity.procrustes, 3),
             ));
+            if let Some(h) = w.holes.as_ref().filter(|h| !h.right()) {
+                s.push_str(&format!("        holes: {}\n", hole_note(h)));
+            }
         }
         for c in &self.connections {
             let truth = c.truth.map_or_else(String::new, |t| {

@@ -182,6 +182,14 @@ pub fn summarise_window(
             .zip(band)
             .map(|((_, fs), (a, b))| fs.betti_in_band(a, b)),
         domain: band.map(|(a, b)| [a, b]),
+        holes: truth.zip(band).and_then(|((_, fs), (a, b))| {
+            let positions = true_positions(m, log)?;
+            Some(crate::eval::holes::check(
+                m,
+                &positions,
+                &fs.holes_in_band(a, b),
+            ))
+        }),
         fidelity: fidelity(
             m,
             log,
