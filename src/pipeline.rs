@@ -257,7 +257,13 @@ fn finish(
                 }),
             })
             .collect();
-        let gt = truth.as_ref().map(|(_, fs)| fs.global_betti());
+        let gt = truth.as_ref().map(|(w, fs)| {
+            let holes = fs.holes_in_band(0.0, w.arena.width);
+            (
+                fs.global_betti(),
+                crate::eval::holes::check_global(&maps, &global, log, &holes),
+            )
+        });
         (ws, cs, gt)
     });
     let summary = Summary {
@@ -267,8 +273,9 @@ fn finish(
         connections: connections_summary,
         global: GlobalSummary {
             betti: global.betti,
-            truth: global_truth,
+            truth: global_truth.as_ref().map(|g| g.0),
             gluing_cycles: global.gluing_cycles,
+            holes: global_truth.and_then(|g| g.1),
         },
         timings: timings.0.clone(),
         alongside: BTreeMap::new(),

@@ -199,6 +199,9 @@ pub struct Score {
     pub connections: usize,
     pub connections_ok: usize,
     pub global_ok: bool,
+    /// Whether the global map's holes are exactly the arena's obstacles
+    /// ([`crate::eval::HoleCheck::right_with_gluing`]); `None` without a hole check.
+    pub global_holes_ok: Option<bool>,
     pub spearman: Vec<f64>,
     pub procrustes: Vec<f64>,
     pub time: f64,
@@ -270,6 +273,10 @@ pub fn score(summary: &serde_json::Value) -> Score {
         s.global = format!("{}:{}", b[0], b[1]);
         s.global_truth = format!("{}:{}", t[0], t[1]);
     }
+    if let Ok(h) = serde_json::from_value::<crate::eval::HoleCheck>(g["holes"].clone()) {
+        let gluing = g["gluing_cycles"].as_u64().unwrap_or(0) as usize;
+        s.global_holes_ok = Some(h.right_with_gluing(gluing));
+    }
     s.time = summary["timings"]
         .as_object()
         .map(|m| m.values().filter_map(|v| v.as_f64()).sum())
@@ -294,12 +301,12 @@ pub fn csv(records: &[RunRecord]) -> String {
     let mut out = String::from(
         "world,params,seed,windows,windows_ok,b0_ok,b1_ok,holeless,holeless_ok,oracle_ok,\
          connections,connections_ok,global,global_truth,global_ok,spearman,procrustes,seconds,\
-         window_betti,window_truth,window_oracle,holes_ok,window_holes,error\n",
+         window_betti,window_truth,window_oracle,holes_ok,window_holes,global_holes_ok,error\n",
     );
     for r in records {
         let s = r.summary.as_ref().map(score).unwrap_or_default();
         out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{},{},{},{}\n",
             r.world,
             quote(&r.params),
             r.seed,
@@ -323,6 +330,8 @@ pub fn csv(records: &[RunRecord]) -> String {
             s.window_oracle,
             s.holes_ok,
             s.window_holes,
+            s.global_holes_ok
+                .map_or(String::new(), |b| u8::from(b).to_string()),
             quote(r.error.as_deref().unwrap_or("")),
         ));
     }
@@ -347,7 +356,7 @@ pub fn table(records: &[RunRecord]) -> String {
             .push(r);
     }
     let mut out = String::from(
-        "world        params                          runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  spearman  procr.  s/run\n",
+        "world        params                          runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  glob. holes  spearman  procr.  s/run\n",
     );
     let pct = |a: usize, b: usize| {
         if b == 0 {
@@ -369,7 +378,7 @@ pub fn table(records: &[RunRecord]) -> String {
         let pr: Vec<f64> = scores.iter().flat_map(|s| s.procrustes.clone()).collect();
         let times: Vec<f64> = scores.iter().map(|s| s.time).collect();
         out.push_str(&format!(
-            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>8.2}  {:>6.3}  {:>5.1}\n",
+            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8.2}  {:>6.3}  {:>5.1}\n",
             world,
             if params.is_empty() { "(defaults)" } else { params },
             rs.len(),
@@ -382,6 +391,10 @@ pub fn table(records: &[RunRecord]) -> String {
             pct(sum(|s| s.oracle_ok), sum(|s| s.oracle)),
             pct(sum(|s| s.connections_ok), sum(|s| s.connections)),
             pct(scores.iter().filter(|s| s.global_ok).count(), scores.len()),
+            pct(
+                scores.iter().filter(|s| s.global_holes_ok == Some(true)).count(),
+                scores.iter().filter(|s| s.global_holes_ok.is_some()).count(),
+            ),
             mean(&sp),
             mean(&pr),
             mean(&times),
@@ -426,7 +439,8 @@ mod tests {
                  "holes": {"truth": [[1.0, 2.0]], "found": [null]}},
             ],
             "connections": [{"count": 2, "truth": 2}, {"count": 1, "truth": 2}],
-            "global": {"betti": [1, 1], "truth": [1, 1]},
+            "global": {"betti": [1, 1], "truth": [1, 1], "gluing_cycles": 1,
+                       "holes": {"truth": [[1.0, 2.0], [5.0, 2.0]], "found": [1]}},
             "timings": {"a": 1.0, "b": 2.0}
         });
         let s = score(&v);
@@ -440,5 +454,6 @@ mod tests {
         assert_eq!(s.window_oracle, "2:1");
         assert_eq!((s.hole_checks, s.holes_ok), (1, 0));
         assert_eq!(s.window_holes, "0/1+1");
+        assert_eq!(s.global_holes_ok, Some(true));
     }
 }

@@ -47,6 +47,14 @@ impl HoleCheck {
         self.found.len() == self.truth.len() && self.matched() == self.truth.len()
     }
 
+    /// Whether a global map found exactly the truth's holes: every local hole it kept
+    /// encircles one true hole of the arena, no two the same one, and the true holes left
+    /// over are as many as its `gluing_cycles` (holes no single window saw whole, which
+    /// carry no cycle to match). With no gluing cycle this is [`HoleCheck::right`].
+    pub fn right_with_gluing(&self, gluing_cycles: usize) -> bool {
+        self.spurious() == 0 && self.found.len() + gluing_cycles == self.truth.len()
+    }
+
     /// Number of true holes that some robust hole encircles.
     pub fn matched(&self) -> usize {
         let mut hit = vec![false; self.truth.len()];
@@ -128,6 +136,38 @@ pub fn check(map: &LocalMap, truth: &[[f64; 2]], holes: &[TrueHole]) -> HoleChec
         truth: holes.iter().map(|h| h.inside).collect(),
         found,
     }
+}
+
+/// Matches the local holes a global map kept (`global.holes`, after merging the holes
+/// two consecutive maps share) to the true holes `holes` of the whole arena
+/// ([`crate::eval::truth::FreeSpace::holes_in_band`] over its width); `None` without the
+/// log's truth columns.
+pub fn check_global(
+    maps: &[LocalMap],
+    global: &crate::mapping::stitch::GlobalMap,
+    log: &crate::log::EncounterLog,
+    holes: &[TrueHole],
+) -> Option<HoleCheck> {
+    let mut positions: std::collections::HashMap<usize, Vec<[f64; 2]>> = Default::default();
+    let mut found = Vec::with_capacity(global.holes.len());
+    for &(window, c, h) in &global.holes {
+        let map = maps.iter().find(|m| m.index == window)?;
+        let truth = match positions.entry(window) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(crate::mapping::pipeline::true_positions(map, log)?)
+            }
+        };
+        let cycle = &map.components.get(c)?.holes.get(h)?.cycle;
+        found.push(match encircled(truth, cycle, holes).as_slice() {
+            [t] => Some(*t),
+            _ => None,
+        });
+    }
+    Some(HoleCheck {
+        truth: holes.iter().map(|h| h.inside).collect(),
+        found,
+    })
 }
 
 #[cfg(test)]
@@ -217,5 +257,11 @@ mod tests {
         assert!(!short.right());
         assert_eq!((short.missed(), short.spurious()), (vec![0], 0));
         assert!(HoleCheck::default().right());
+        // A global map: one hole found by a window, one closed by the gluing graph.
+        let glued = h(vec![Some(1)]);
+        assert!(glued.right_with_gluing(1));
+        assert!(!glued.right_with_gluing(0));
+        assert!(!h(vec![Some(1), None]).right_with_gluing(0));
+        assert!(h(vec![Some(1), Some(0)]).right_with_gluing(0));
     }
 }

@@ -68,6 +68,10 @@ pub struct GlobalSummary {
     pub truth: Option<[usize; 2]>,
     /// Cycle rank of the gluing graph (holes no single window saw whole).
     pub gluing_cycles: usize,
+    /// The local holes the global map kept, matched to the arena's true holes (with a
+    /// world and the log's truth columns; [`crate::eval::holes::check_global`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holes: Option<crate::eval::HoleCheck>,
 }
 
 /// `summary.json`.
@@ -363,6 +367,27 @@ impl Summary {
             "global (β0,β1): {}\n",
             betti_cell(self.global.betti, self.global.truth)
         ));
+        if let Some(h) = self
+            .global
+            .holes
+            .as_ref()
+            .filter(|h| !h.right_with_gluing(self.global.gluing_cycles))
+        {
+            let note = hole_note(h);
+            s.push_str(&format!(
+                "        holes: {}\n",
+                if note.is_empty() {
+                    format!(
+                        "{} of the obstacles found by windows, {} closed by gluing, {} in the truth",
+                        h.found.len(),
+                        self.global.gluing_cycles,
+                        h.truth.len()
+                    )
+                } else {
+                    note
+                }
+            ));
+        }
         let total: f64 = self.timings.values().sum();
         let parts: Vec<String> = self
             .timings
