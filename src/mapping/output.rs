@@ -373,20 +373,32 @@ impl Summary {
             .as_ref()
             .filter(|h| !h.right_with_gluing(self.global.gluing_cycles))
         {
-            let note = hole_note(h);
-            s.push_str(&format!(
-                "        holes: {}\n",
-                if note.is_empty() {
-                    format!(
-                        "{} of the obstacles found by windows, {} closed by gluing, {} in the truth",
-                        h.found.len(),
-                        self.global.gluing_cycles,
-                        h.truth.len()
-                    )
-                } else {
-                    note
-                }
-            ));
+            // A gluing cycle closes a hole no window saw whole, with no cycle to match, so
+            // the obstacles no local hole encircles are not all missed: say how many the
+            // gluing graph accounts for.
+            let missed: Vec<String> = h
+                .missed()
+                .iter()
+                .map(|&t| format!("({:.1}, {:.1})", h.truth[t][0], h.truth[t][1]))
+                .collect();
+            let mut note = format!(
+                "{} of the {} obstacles found by windows, {} closed by gluing",
+                h.matched(),
+                h.truth.len(),
+                self.global.gluing_cycles
+            );
+            if !missed.is_empty() {
+                note.push_str(&format!(
+                    "; no window's hole encircles {}",
+                    missed.join(", ")
+                ));
+            }
+            match h.spurious() {
+                0 => {}
+                1 => note.push_str("; 1 hole encircles no obstacle of its own"),
+                n => note.push_str(&format!("; {n} holes encircle no obstacle of their own")),
+            }
+            s.push_str(&format!("        holes: {note}\n"));
         }
         let total: f64 = self.timings.values().sum();
         let parts: Vec<String> = self
@@ -407,5 +419,80 @@ impl Summary {
             ));
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::HoleCheck;
+
+    fn window(betti: [usize; 2], truth: [usize; 2], holes: HoleCheck) -> WindowSummary {
+        WindowSummary {
+            index: 1,
+            start: 0.0,
+            end: 100.0,
+            events: 10,
+            betti,
+            truth: Some(truth),
+            domain: Some([0.0, 8.0]),
+            fidelity: Fidelity::default(),
+            holes: Some(holes),
+        }
+    }
+
+    /// The run table names the obstacles a wrong window missed and its holes that are no
+    /// obstacle, and for the global map says how many obstacles the gluing graph closes.
+    #[test]
+    fn the_table_names_missed_obstacles_and_false_holes() {
+        let truth = vec![[2.5, 7.0], [6.3, 3.0]];
+        let summary = Summary {
+            world: "w".into(),
+            seed: Some(1),
+            windows: vec![
+                window(
+                    [1, 2],
+                    [1, 2],
+                    HoleCheck {
+                        truth: truth.clone(),
+                        found: vec![Some(1), Some(0)],
+                    },
+                ),
+                window(
+                    [1, 2],
+                    [1, 2],
+                    HoleCheck {
+                        truth: truth.clone(),
+                        found: vec![Some(0), None],
+                    },
+                ),
+            ],
+            connections: Vec::new(),
+            global: GlobalSummary {
+                betti: [1, 2],
+                truth: Some([1, 3]),
+                gluing_cycles: 1,
+                holes: Some(HoleCheck {
+                    truth: vec![[2.5, 7.0], [6.3, 3.0], [15.0, 5.0]],
+                    found: vec![Some(0)],
+                }),
+            },
+            timings: BTreeMap::from([("mapping".to_string(), 1.0)]),
+            alongside: BTreeMap::new(),
+        };
+        let t = summary.table();
+        let holes: Vec<&str> = t
+            .lines()
+            .filter(|l| l.trim_start().starts_with("holes:"))
+            .collect();
+        assert_eq!(
+            holes,
+            vec![
+                "        holes: missed the obstacle at (6.3, 3.0); 1 hole encircles no obstacle of its own",
+                "        holes: 1 of the 3 obstacles found by windows, 1 closed by gluing; \
+                 no window's hole encircles (6.3, 3.0), (15.0, 5.0)",
+            ],
+            "{t}"
+        );
     }
 }
