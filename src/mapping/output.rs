@@ -374,22 +374,22 @@ impl Summary {
             .filter(|h| !h.right_with_gluing(self.global.gluing_cycles))
         {
             // A gluing cycle closes a hole no window saw whole, with no cycle to match, so
-            // the obstacles no local hole encircles are not all missed: say how many the
-            // gluing graph accounts for.
+            // the obstacles none of the kept local holes encircles are not all missed: say
+            // how many the gluing graph accounts for.
             let missed: Vec<String> = h
                 .missed()
                 .iter()
                 .map(|&t| format!("({:.1}, {:.1})", h.truth[t][0], h.truth[t][1]))
                 .collect();
             let mut note = format!(
-                "{} of the {} obstacles found by windows, {} closed by gluing",
+                "{} of the {} obstacles are local holes of the global map, {} closed by gluing",
                 h.matched(),
                 h.truth.len(),
                 self.global.gluing_cycles
             );
             if !missed.is_empty() {
                 note.push_str(&format!(
-                    "; no window's hole encircles {}",
+                    "; none of its local holes encircles {}",
                     missed.join(", ")
                 ));
             }
@@ -489,8 +489,8 @@ mod tests {
             holes,
             vec![
                 "        holes: missed the obstacle at (6.3, 3.0); 1 hole encircles no obstacle of its own",
-                "        holes: 1 of the 3 obstacles found by windows, 1 closed by gluing; \
-                 no window's hole encircles (6.3, 3.0), (15.0, 5.0)",
+                "        holes: 1 of the 3 obstacles are local holes of the global map, 1 closed by \
+                 gluing; none of its local holes encircles (6.3, 3.0), (15.0, 5.0)",
             ],
             "{t}"
         );
