@@ -468,35 +468,24 @@ mod tests {
     }
 
     /// Window `index` whose only component has one hole, a loop through `events` (indices
-    /// into the log).
+    /// into the log), all at one point of the plane (so no two maps have a common plane
+    /// and holes are compared by time).
     fn map_with_hole(index: usize, events: Vec<usize>) -> LocalMap {
         let n = events.len();
-        let cycle = (0..n)
-            .map(|k| (k.min((k + 1) % n), k.max((k + 1) % n)))
-            .collect();
-        LocalMap {
-            index,
-            start: 0.0,
-            end: 0.0,
-            events,
-            points: vec![[0.0; 3]; n],
-            noise: vec![false; n],
-            components: vec![Component {
-                events: (0..n).collect(),
-                representatives: (0..n).collect(),
-                scale: 1.0,
-                diagram: Vec::new(),
-                betti: [1, 1],
-                holes: vec![Hole {
-                    birth: 1.0,
-                    death: 2.0,
-                    cycle,
-                    void: None,
-                }],
-            }],
-            betti: [1, 1],
-            explained: 1.0,
-            rows: Vec::new(),
+        planar_map(index, events, vec![[0.0; 2]; n], &[(0..n).collect()])
+    }
+
+    /// One connection between W_1 and W_2, joining their first components.
+    fn one_join() -> Connection {
+        Connection {
+            between: [1, 2],
+            static_agents: Vec::new(),
+            points: Vec::new(),
+            labels: Vec::new(),
+            metric: None,
+            heights: Vec::new(),
+            count: 1,
+            joins: vec![(0, 0)],
         }
     }
 
@@ -525,16 +514,7 @@ mod tests {
         let m1 = map_with_hole(1, (0..11).collect());
         let distinct = map_with_hole(2, (11..22).collect());
         let same = map_with_hole(2, (22..32).collect());
-        let join = Connection {
-            between: [1, 2],
-            static_agents: Vec::new(),
-            points: Vec::new(),
-            labels: Vec::new(),
-            metric: None,
-            heights: Vec::new(),
-            count: 1,
-            joins: vec![(0, 0)],
-        };
+        let join = one_join();
         let g = global_map(&[m1.clone(), distinct], std::slice::from_ref(&join), &log);
         assert_eq!(g.betti, [1, 2]);
         let g = global_map(&[m1, same], std::slice::from_ref(&join), &log);
@@ -637,16 +617,7 @@ mod tests {
                 &[(40..50).collect()],
             )
         };
-        let join = Connection {
-            between: [1, 2],
-            static_agents: Vec::new(),
-            points: Vec::new(),
-            labels: Vec::new(),
-            metric: None,
-            heights: Vec::new(),
-            count: 1,
-            joins: vec![(0, 0)],
-        };
+        let join = one_join();
         let joins = std::slice::from_ref(&join);
         let same = second(50..60, [0.0, 0.0]);
         assert_eq!(
