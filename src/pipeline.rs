@@ -7,7 +7,6 @@
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
 use crate::io::write_atomic;
 use crate::log::{EncounterLog, LogError};
-use crate::mapping::classify::Classifier;
 use crate::mapping::local::LocalMap;
 use crate::mapping::local::local_map;
 use crate::mapping::output::WindowSummary;
@@ -63,8 +62,6 @@ pub struct Mapped {
     pub connections: Vec<Connection>,
     pub global: GlobalMap,
     pub summary: Summary,
-    /// The classifier the diagrams were judged with (recorded in `maps/window_<i>.json`).
-    pub classifier: Classifier,
     /// The stitching parameters (the cut-off is recorded in `maps/connection_<i>.json`).
     pub stitch: StitchParams,
 }
@@ -285,7 +282,6 @@ fn finish(
         connections,
         global,
         summary,
-        classifier: cfg.local.classifier,
         stitch: *stitch,
     })
 }
@@ -301,7 +297,7 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     for (map, s) in m.maps.iter().zip(&m.summary.windows) {
         write(
             format!("maps/window_{}.json", map.index),
-            window_json(map, log, s.truth, &m.classifier),
+            window_json(map, log, s.truth),
         )?;
     }
     for c in &m.connections {

@@ -1,6 +1,7 @@
 //! `swarmmap calibrate`: it replaces exactly the entry it fits in the model file (a method's,
-//! or the truth-position oracle's with `--oracle`), keeps the others, and says what it was
-//! fitted on.
+//! or the truth-position oracle's with `--oracle`, or both with `--with-oracle`), keeps the
+//! others, says what it was fitted on and at what density, and a fit at another sampling
+//! density joins the method's bank instead of replacing it.
 
 use assert_cmd::Command;
 use predicates::str::contains;
@@ -35,10 +36,11 @@ fn calibrate_replaces_only_the_fitted_entry() {
     let m = models(&out);
     assert!(
         m.paper
+            .first()
             .fitted_on
             .starts_with("swarmmap calibrate --seeds 1,2 ")
     );
-    assert!(m.paper.fitted_on.contains("tiny.ron: 4 windows"));
+    assert!(m.paper.first().fitted_on.contains("tiny.ron: 4 windows"));
     assert_eq!(m.embedded, shipped.embedded);
     assert_eq!(m.oracle, shipped.oracle);
 
@@ -46,6 +48,7 @@ fn calibrate_replaces_only_the_fitted_entry() {
     let m2 = models(&out);
     assert!(
         m2.oracle
+            .first()
             .fitted_on
             .starts_with("swarmmap calibrate --oracle --seeds 1,2 ")
     );
@@ -117,9 +120,9 @@ fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
     assert!(stdout.contains("/2 right"), "{stdout}");
     let m = models(&out);
     assert!(
-        m.paper.fitted_on.contains("; held out by seed: "),
+        m.paper.first().fitted_on.contains("; held out by seed: "),
         "{}",
-        m.paper.fitted_on
+        m.paper.first().fitted_on
     );
 
     // One training world cannot be held out against the others.
@@ -168,7 +171,7 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
         .map(|r| r[4].parse::<usize>().unwrap())
         .max()
         .unwrap();
-    let c = models(&out).paper.classifier;
+    let c = models(&out).paper.first().classifier;
     let fitted = rows
         .iter()
         .find(|r| {
@@ -176,4 +179,111 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
         })
         .expect("the fitted rule is a grid point");
     assert_eq!(fitted[4].parse::<usize>().unwrap(), best);
+}
+
+/// One calibration fits the method's and the oracle's models from the same runs, and each
+/// records the density of its training windows.
+#[test]
+fn with_oracle_fits_both_entries_from_one_set_of_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    std::fs::write(&out, SHIPPED).unwrap();
+    let shipped = Models::shipped();
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args([
+            "calibrate",
+            WORLD,
+            "--seeds",
+            "1,2",
+            "--jobs",
+            "1",
+            "--with-oracle",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("Paper: h0_ratio"))
+        .stdout(contains("Oracle: h0_ratio"))
+        .stdout(contains("encounters per Rips vertex"));
+    let m = models(&out);
+    assert_eq!(m.embedded, shipped.embedded);
+    for (bank, prefix) in [
+        (&m.paper, "swarmmap calibrate --seeds 1,2 "),
+        (&m.oracle, "swarmmap calibrate --oracle --seeds 1,2 "),
+    ] {
+        assert_eq!(bank.0.len(), 1, "the density-free shipped model gives way");
+        let fit = bank.first();
+        assert!(fit.fitted_on.starts_with(prefix), "{}", fit.fitted_on);
+        let d = fit.events_per_point.expect("the density is recorded");
+        assert!(
+            d.min <= d.median && d.median <= d.max && d.min > 0.0,
+            "{d:?}"
+        );
+    }
+    // The oracle samples the same events with as many points: the same density.
+    assert_eq!(
+        m.paper.first().events_per_point,
+        m.oracle.first().events_per_point
+    );
+}
+
+/// A fit at a sparser sampling (a third of the representatives: about three times the
+/// encounters per Rips vertex) joins the bank; a refit at the first sampling replaces its
+/// model; `--only` leaves one model. Maps made with the bank record the density and the
+/// model that judged them.
+#[test]
+fn a_fit_at_another_density_joins_the_bank() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    std::fs::write(&out, SHIPPED).unwrap();
+    calibrate(&out, &[]);
+    let dense = models(&out).paper.first().clone();
+    calibrate(&out, &["--set", "mapping.subsample=50"]);
+    let m = models(&out);
+    assert_eq!(m.paper.0.len(), 2, "{:?}", m.paper);
+    assert_eq!(
+        m.paper.0[0], dense,
+        "ordered by density, the denser sampling first"
+    );
+    let sparse = m.paper.0[1].clone();
+    assert!(sparse.fitted_on.contains("--set mapping.subsample=50 "));
+    assert!(sparse.events_per_point.unwrap().median > 2.0 * dense.events_per_point.unwrap().median);
+    calibrate(&out, &[]);
+    assert_eq!(models(&out).paper.0, vec![dense.clone(), sparse.clone()]);
+    calibrate(&out, &["--only"]);
+    let only = models(&out).paper;
+    assert_eq!(only.0.len(), 1);
+    assert!(
+        only.first()
+            .fitted_on
+            .starts_with("swarmmap calibrate --only --seeds 1,2 ")
+    );
+
+    // A run mapped with a two-model bank records each window's density and the model of
+    // the nearest one.
+    let mut bank = models(&out);
+    bank.paper.0 = vec![dense.clone(), sparse.clone()];
+    bank.paper.0[1].classifier.h1_ratio = 1e9;
+    let model = dir.path().join("bank.json");
+    std::fs::write(&model, serde_json::to_string(&bank).unwrap()).unwrap();
+    let run = dir.path().join("run");
+    for (sub, ratio) in [("150", dense.classifier.h1_ratio), ("50", 1e9)] {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .arg("--model")
+            .arg(&model)
+            .args(["run", WORLD, "--seed", "1", "--no-report", "--set"])
+            .arg(format!("mapping.subsample={sub}"))
+            .arg("--out")
+            .arg(&run)
+            .assert()
+            .success();
+        let w: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.join("maps/window_1.json")).unwrap())
+                .unwrap();
+        assert_eq!(w["classifier"]["h1_ratio"], ratio, "subsample {sub}");
+        assert!(w["events_per_point"].as_f64().unwrap() > 1.0);
+    }
 }

@@ -67,6 +67,8 @@ fn map_with(truth_len: usize, cycles: Vec<Vec<(usize, usize)>>) -> LocalMap {
         }],
         betti: [1, 0],
         explained: 1.0,
+        events_per_point: 1.0,
+        classifier: swarmmap::mapping::classify::Classifier::default(),
         rows: Vec::new(),
     }
 }

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit, h1_landscape};
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
-use swarmmap::mapping::classify::Models;
+use swarmmap::mapping::classify::{Density, Model, Models};
 use swarmmap::mapping::pipeline::{MapConfig, map_windows, oracle_features, true_positions};
 use swarmmap::sim::{SimOptions, simulate};
 use swarmmap::world::{MappingMethod, World};
@@ -29,14 +29,24 @@ pub struct CalibrateArgs {
     /// Runs in parallel (default: the number of cores).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Model file to update: the fitted method's entry is replaced, the others kept
-    /// (default: `assets/classifier.json`, the model compiled into swarmmap).
+    /// Model file to update (default: `assets/classifier.json`, the model compiled into
+    /// swarmmap). The fitted model replaces the models of the fitted method (or the oracle)
+    /// that were fitted at a density inside its training windows' range of encounters per
+    /// Rips vertex, and joins the others: a fit at another sampling adds a model to the
+    /// method's bank, a refit at the same sampling replaces it. Other methods are kept.
     #[arg(long, default_value = "assets/classifier.json")]
     pub out: PathBuf,
+    /// Make the fitted model the method's only one, whatever the densities of the others.
+    #[arg(long)]
+    pub only: bool,
     /// Fit the truth-position oracle's model instead (the `Embedded` topology stage on the
     /// events' true positions; `summary.json` `fidelity.oracle`) and replace its entry.
     #[arg(long)]
     pub oracle: bool,
+    /// Fit the method's model and the oracle's from the same training runs (one
+    /// simulation per world and seed instead of two).
+    #[arg(long, conflicts_with = "oracle")]
+    pub with_oracle: bool,
     /// Largest share of the training windows without a true hole in which the fitted model
     /// may report one; accuracy is maximised under this constraint (`1` = unconstrained).
     #[arg(long, default_value_t = swarmmap::eval::calibrate::MAX_FALSE_HOLES)]
@@ -121,7 +131,15 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         .build()
         .map_err(|e| Failure::Other(e.into()))?;
     let oracle = args.oracle;
-    type Job = (Target, Vec<Sample>, String, u64);
+    // The fits each run feeds: the method's, the oracle's, or both.
+    let mut targets = Vec::new();
+    if !oracle {
+        targets.push(false);
+    }
+    if oracle || args.with_oracle {
+        targets.push(true);
+    }
+    type Job = Vec<(Target, Vec<Sample>, Vec<f64>, String, u64)>;
     let results: Vec<Result<Job, String>> = pool.install(|| {
         jobs.par_iter()
             .map(|&(world, seed)| {
@@ -129,32 +147,47 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     .map_err(|e| format!("{} seed {seed}: {e}", world.name))?;
                 let cfg = MapConfig::for_world(world);
                 let fs = FreeSpace::for_world(world).map_err(|e| e.to_string())?;
-                let samples = cfg
+                let maps = map_windows(&out.log, &cfg);
+                let densities: Vec<f64> = maps.iter().map(|m| m.events_per_point).collect();
+                let truths: Vec<[usize; 2]> = cfg
                     .windows()
                     .iter()
-                    .zip(map_windows(&out.log, &cfg))
-                    .map(|(w, m)| {
+                    .map(|w| {
                         let (a, b) = window_band(world, w.start, w.end);
-                        let truth = fs.betti_in_band(a, b);
-                        if !oracle {
-                            return Ok(Sample::from_map(&m, truth));
-                        }
-                        let positions = true_positions(&m, &out.log).ok_or_else(|| {
-                            format!("{} seed {seed}: the log has no truth columns", world.name)
-                        })?;
-                        Ok(Sample {
-                            components: oracle_features(&m, &positions, world.mapping.rips_points),
-                            truth,
-                        })
+                        fs.betti_in_band(a, b)
                     })
-                    .collect::<Result<_, String>>()?;
+                    .collect();
+                let mut fits = Vec::new();
+                for &for_oracle in &targets {
+                    let samples = maps
+                        .iter()
+                        .zip(&truths)
+                        .map(|(m, &truth)| {
+                            if !for_oracle {
+                                return Ok(Sample::from_map(m, truth));
+                            }
+                            let positions = true_positions(m, &out.log).ok_or_else(|| {
+                                format!("{} seed {seed}: the log has no truth columns", world.name)
+                            })?;
+                            Ok(Sample {
+                                components: oracle_features(
+                                    m,
+                                    &positions,
+                                    world.mapping.rips_points,
+                                ),
+                                truth,
+                            })
+                        })
+                        .collect::<Result<_, String>>()?;
+                    let target = if for_oracle {
+                        Target::Oracle
+                    } else {
+                        Target::Method(world.mapping.method)
+                    };
+                    fits.push((target, samples, densities.clone(), world.name.clone(), seed));
+                }
                 eprintln!("calibrate: {} seed {seed} done", world.name);
-                let target = if oracle {
-                    Target::Oracle
-                } else {
-                    Target::Method(world.mapping.method)
-                };
-                Ok((target, samples, world.name.clone(), seed))
+                Ok(fits)
             })
             .collect()
     });
@@ -165,17 +198,24 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         Err(_) => Models::active(),
     };
     let mut by_method: Vec<Training> = Vec::new();
-    for r in results {
-        let (target, samples, world, seed) = r.map_err(|e| Failure::Other(anyhow!(e)))?;
+    for (target, samples, densities, world, seed) in results
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| Failure::Other(anyhow!(e)))?
+        .into_iter()
+        .flatten()
+    {
         let origin = vec![(world, seed); samples.len()];
         match by_method.iter_mut().find(|t| t.target == target) {
             Some(t) => {
                 t.samples.extend(samples);
+                t.densities.extend(densities);
                 t.origin.extend(origin);
             }
             None => by_method.push(Training {
                 target,
                 samples,
+                densities,
                 origin,
             }),
         }
@@ -187,6 +227,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     for Training {
         target: method,
         samples,
+        densities,
         origin,
     } in &by_method
     {
@@ -246,14 +287,24 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 100.0 * cv.false_holes
             ));
         }
-        let m = match method {
+        let bank = match method {
             Target::Method(method) => models.get_mut(*method),
             Target::Oracle => &mut models.oracle,
         };
-        m.classifier = f.classifier;
-        m.fitted_on = format!(
-            "swarmmap calibrate{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
-            if oracle { " --oracle" } else { "" },
+        let density = Density::of(densities);
+        if let Some(d) = density {
+            println!(
+                "  fitted at {:.2}–{:.2} encounters per Rips vertex (median {:.2})",
+                d.min, d.max, d.median
+            );
+        }
+        let fitted_on = format!(
+            "swarmmap calibrate{}{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
+            match method {
+                Target::Oracle => " --oracle",
+                Target::Method(_) => "",
+            },
+            if args.only { " --only" } else { "" },
             args.seeds,
             args.max_false_holes,
             args.cross_validate
@@ -271,6 +322,22 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         ) + &held_out;
+        let model = Model {
+            classifier: f.classifier,
+            fitted_on,
+            events_per_point: density,
+        };
+        if args.only {
+            bank.0 = vec![model];
+        } else {
+            bank.insert(model);
+        }
+        println!(
+            "  {} now holds {} model{}",
+            target_name(method),
+            bank.0.len(),
+            if bank.0.len() == 1 { "" } else { "s" }
+        );
     }
     if let Some(path) = &args.landscape {
         write_atomic(path, csv.as_bytes())
@@ -330,6 +397,9 @@ fn print_cross_validation(groups: CvGroups, cv: &CrossValidation) {
 struct Training {
     target: Target,
     samples: Vec<Sample>,
+    /// Each sample's encounters per Rips vertex (the map's, also for the oracle, which
+    /// samples the same events with as many points).
+    densities: Vec<f64>,
     origin: Vec<(String, u64)>,
 }
 

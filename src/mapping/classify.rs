@@ -16,7 +16,10 @@
 //!   relative to a tiny birth.
 //!
 //! The three thresholds are fitted by `swarmmap calibrate` on training worlds and shipped as
-//! the default model in `assets/classifier.json`.
+//! the default models in `assets/classifier.json`. σ makes them free of the metric's unit
+//! but not of the sampling: each model also records the density it was fitted at (encounters
+//! per vertex of the Rips complexes, [`Density`]), a method may carry several ([`Bank`]),
+//! and each window is judged by the one fitted nearest its own density.
 
 use serde::{Deserialize, Serialize};
 
@@ -32,20 +35,20 @@ pub struct Classifier {
     pub h1_span: f64,
 }
 
-/// The shipped models, one per mapping method (`assets/classifier.json`), with a note on
-/// what each was fitted on.
+/// The shipped models, one bank per mapping method (`assets/classifier.json`), each model
+/// with a note on what it was fitted on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Models {
     #[serde(rename = "Paper")]
-    pub paper: Model,
+    pub paper: Bank,
     #[serde(rename = "Embedded")]
-    pub embedded: Model,
-    /// The truth-position oracle's model ([`crate::mapping::output::Fidelity::oracle`]):
+    pub embedded: Bank,
+    /// The truth-position oracle's models ([`crate::mapping::output::Fidelity::oracle`]):
     /// fitted on the same stage run on true positions, whose diagrams are far less noisy
     /// than those of estimated clouds (`swarmmap calibrate --oracle`).
     #[serde(rename = "Oracle")]
-    pub oracle: Model,
+    pub oracle: Bank,
 }
 
 /// A fitted classifier and its provenance.
@@ -55,6 +58,141 @@ pub struct Model {
     pub classifier: Classifier,
     /// How it was fitted (command, worlds, seeds) and its training accuracy.
     pub fitted_on: String,
+    /// The sampling density of its training windows ([`Density`]); `None` in model files
+    /// written before densities were recorded, which serve every window.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub events_per_point: Option<Density>,
+}
+
+/// Encounters per vertex of the Rips complexes over a model's training windows
+/// ([`crate::mapping::local::LocalMap::events_per_point`]): the least, the median and the
+/// most.
+///
+/// Why a model is tied to a density: the thresholds are scale-free in the metric's units
+/// (σ), but not in the sampling. With twice the Rips points at the same sweep (2.8–4.2
+/// encounters per point instead of 5.5–8.3), the diagrams hold many more short noise loops,
+/// σ shrinks, and the model fitted at the sparser sampling shows false holes; a model
+/// fitted at the denser sampling asks for a life of 8.75 σ instead of 4.25 σ (README
+/// "Accuracy", step 28). A slower sweep with twice the points lands back at the sparser
+/// density, where the first model serves (step 29).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Density {
+    pub min: f64,
+    pub median: f64,
+    pub max: f64,
+}
+
+impl Density {
+    /// The density range of some windows' densities (`None` if there are none, or none is
+    /// positive and finite).
+    pub fn of(values: &[f64]) -> Option<Self> {
+        let mut v: Vec<f64> = values
+            .iter()
+            .copied()
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        Some(Self {
+            min: v[0],
+            median: v[v.len() / 2],
+            max: v[v.len() - 1],
+        })
+    }
+}
+
+/// The models of one method, each fitted at its own sampling density. A window is judged
+/// by the model whose training windows' median density is nearest its own, as a ratio
+/// (|ln d − ln median|; the first on a tie). In JSON a bank is one model object, or an
+/// array of them, each with its `events_per_point`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bank(pub Vec<Model>);
+
+impl Serialize for Bank {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self.0.as_slice() {
+            [one] => one.serialize(s),
+            many => many.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Bank {
+    /// Reads the object or the array as it streams (not through an untagged enum, which
+    /// buffers the value and loses the position and the reason of a fault inside it).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct BankVisitor;
+        impl<'de> serde::de::Visitor<'de> for BankVisitor {
+            type Value = Bank;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a model object or a list of model objects")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Bank, A::Error> {
+                let one = Model::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Bank(vec![one]))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Bank, A::Error> {
+                Vec::<Model>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
+                    .map(Bank)
+            }
+        }
+        d.deserialize_any(BankVisitor)
+    }
+}
+
+impl Bank {
+    /// A bank of one model fitted at no recorded density.
+    pub fn single(classifier: Classifier) -> Self {
+        Bank(vec![Model {
+            classifier,
+            fitted_on: String::new(),
+            events_per_point: None,
+        }])
+    }
+
+    /// The model a window of `events_per_point` encounters per Rips vertex is judged by.
+    pub fn pick(&self, events_per_point: f64) -> &Model {
+        if self.0.len() > 1 && events_per_point.is_finite() && events_per_point > 0.0 {
+            let far = |m: &Model| {
+                m.events_per_point
+                    .map_or(f64::INFINITY, |d| (events_per_point / d.median).ln().abs())
+            };
+            let mut best = &self.0[0];
+            for m in &self.0[1..] {
+                if far(m) < far(best) {
+                    best = m;
+                }
+            }
+            return best;
+        }
+        &self.0[0]
+    }
+
+    /// The first model (the only one of a bank of one).
+    pub fn first(&self) -> &Model {
+        &self.0[0]
+    }
+
+    /// Puts `model` in the bank: it replaces every model whose median density lies within
+    /// its training range (or every model, if either side has no recorded density), and
+    /// joins the others, the bank kept in order of median density.
+    pub fn insert(&mut self, model: Model) {
+        match model.events_per_point {
+            None => self.0.clear(),
+            Some(d) => self.0.retain(|m| {
+                m.events_per_point
+                    .is_some_and(|e| e.median < d.min || e.median > d.max)
+            }),
+        }
+        self.0.push(model);
+        self.0.sort_by(|a, b| {
+            let key = |m: &Model| m.events_per_point.map_or(0.0, |d| d.median);
+            key(a).total_cmp(&key(b))
+        });
+    }
 }
 
 /// The text of the shipped models.
@@ -91,50 +229,85 @@ impl Models {
             anyhow::anyhow!(
                 "{}:{}:{}: not a model file: {e}; a model file is what `swarmmap calibrate \
                  --out FILE` writes: an object with \"Paper\", \"Embedded\" and \"Oracle\" \
-                 entries, each {{\"classifier\": {{\"h0_ratio\", \"h1_ratio\", \"h1_span\"}}, \
-                 \"fitted_on\"}} (see assets/classifier.json)",
+                 entries, each a model {{\"classifier\": {{\"h0_ratio\", \"h1_ratio\", \
+                 \"h1_span\"}}, \"fitted_on\"}} or a list of models that also carry \
+                 \"events_per_point\": {{\"min\", \"median\", \"max\"}} (see assets/classifier.json)",
                 path.display(),
                 e.line(),
                 e.column()
             )
         })?;
-        for (name, m) in [
+        for (name, bank) in [
             ("Paper", &models.paper),
             ("Embedded", &models.embedded),
             ("Oracle", &models.oracle),
         ] {
-            let c = m.classifier;
-            let ok = c.h0_ratio.is_finite()
-                && c.h0_ratio > 0.0
-                && c.h1_ratio.is_finite()
-                && c.h1_ratio >= 1.0
-                && c.h1_span.is_finite()
-                && c.h1_span >= 0.0;
-            if !ok {
+            if bank.0.is_empty() {
                 anyhow::bail!(
-                    "{}: the {name} model's thresholds (h0_ratio {}, h1_ratio {}, h1_span {}) \
-                     are out of range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, \
-                     all finite",
-                    path.display(),
-                    c.h0_ratio,
-                    c.h1_ratio,
-                    c.h1_span
+                    "{}: the {name} entry is an empty list; give at least one model",
+                    path.display()
                 );
+            }
+            if bank.0.len() > 1 && bank.0.iter().any(|m| m.events_per_point.is_none()) {
+                anyhow::bail!(
+                    "{}: the {name} entry lists {} models but not every one has \
+                     \"events_per_point\" ({{\"min\", \"median\", \"max\"}}), which picks the \
+                     model of each window; a list needs it on every model (calibrate writes it)",
+                    path.display(),
+                    bank.0.len()
+                );
+            }
+            for m in &bank.0 {
+                let c = m.classifier;
+                let ok = c.h0_ratio.is_finite()
+                    && c.h0_ratio > 0.0
+                    && c.h1_ratio.is_finite()
+                    && c.h1_ratio >= 1.0
+                    && c.h1_span.is_finite()
+                    && c.h1_span >= 0.0;
+                if !ok {
+                    anyhow::bail!(
+                        "{}: the {name} model's thresholds (h0_ratio {}, h1_ratio {}, h1_span {}) \
+                         are out of range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, \
+                         all finite",
+                        path.display(),
+                        c.h0_ratio,
+                        c.h1_ratio,
+                        c.h1_span
+                    );
+                }
+                if let Some(d) = m.events_per_point {
+                    let ok = [d.min, d.median, d.max]
+                        .iter()
+                        .all(|x| x.is_finite() && *x > 0.0)
+                        && d.min <= d.median
+                        && d.median <= d.max;
+                    if !ok {
+                        anyhow::bail!(
+                            "{}: the {name} model's events_per_point ({}, {}, {}) must be \
+                             positive and finite with min ≤ median ≤ max",
+                            path.display(),
+                            d.min,
+                            d.median,
+                            d.max
+                        );
+                    }
+                }
             }
         }
         Ok(models)
     }
 
-    /// The model of a method.
-    pub fn get(&self, method: crate::world::MappingMethod) -> &Model {
+    /// The models of a method.
+    pub fn get(&self, method: crate::world::MappingMethod) -> &Bank {
         match method {
             crate::world::MappingMethod::Paper => &self.paper,
             crate::world::MappingMethod::Embedded => &self.embedded,
         }
     }
 
-    /// Mutable access to the model of a method.
-    pub fn get_mut(&mut self, method: crate::world::MappingMethod) -> &mut Model {
+    /// Mutable access to the models of a method.
+    pub fn get_mut(&mut self, method: crate::world::MappingMethod) -> &mut Bank {
         match method {
             crate::world::MappingMethod::Paper => &mut self.paper,
             crate::world::MappingMethod::Embedded => &mut self.embedded,
@@ -145,7 +318,7 @@ impl Models {
 impl Default for Classifier {
     /// The shipped model of the paper's method.
     fn default() -> Self {
-        Models::shipped().paper.classifier
+        Models::shipped().paper.first().classifier
     }
 }
 
@@ -248,8 +421,137 @@ mod tests {
     #[test]
     fn shipped_model_loads() {
         let m = Models::shipped();
-        for c in [m.paper.classifier, m.embedded.classifier] {
-            assert!(c.h0_ratio > 0.0 && c.h1_ratio >= 1.0 && c.h1_span >= 0.0);
+        for bank in [&m.paper, &m.embedded, &m.oracle] {
+            assert!(!bank.0.is_empty());
+            for model in &bank.0 {
+                let c = model.classifier;
+                assert!(c.h0_ratio > 0.0 && c.h1_ratio >= 1.0 && c.h1_span >= 0.0);
+            }
+            if bank.0.len() > 1 {
+                assert!(bank.0.iter().all(|m| m.events_per_point.is_some()));
+            }
         }
+    }
+
+    fn model(h1_ratio: f64, density: Option<[f64; 3]>) -> Model {
+        Model {
+            classifier: Classifier {
+                h0_ratio: 50.0,
+                h1_ratio,
+                h1_span: 1.0,
+            },
+            fitted_on: format!("ratio {h1_ratio}"),
+            events_per_point: density.map(|[min, median, max]| Density { min, median, max }),
+        }
+    }
+
+    /// A window is judged by the model whose median density is nearest its own as a
+    /// ratio: 4.5 is nearer 3.4 than 6.8 in ratio (1.32 against 1.51) though nearer 6.8
+    /// in difference.
+    #[test]
+    fn a_window_takes_the_model_nearest_its_density_as_a_ratio() {
+        let bank = Bank(vec![
+            model(2.0, Some([2.8, 3.4, 4.2])),
+            model(3.0, Some([5.5, 6.8, 8.3])),
+        ]);
+        let ratio = |d: f64| bank.pick(d).classifier.h1_ratio;
+        assert_eq!(ratio(1.0), 2.0);
+        assert_eq!(ratio(3.4), 2.0);
+        assert_eq!(ratio(4.5), 2.0);
+        assert_eq!(ratio(5.0), 3.0);
+        assert_eq!(ratio(40.0), 3.0);
+        // Undefined densities (a window without components) take the first model.
+        assert_eq!(ratio(0.0), 2.0);
+        assert_eq!(ratio(f64::NAN), 2.0);
+        // A bank of one serves every density.
+        let one = Bank(vec![model(5.0, None)]);
+        assert_eq!(one.pick(0.1).classifier.h1_ratio, 5.0);
+        assert_eq!(one.pick(100.0).classifier.h1_ratio, 5.0);
+    }
+
+    /// A refit at the same sampling replaces the model; a fit at another joins the bank,
+    /// kept in order of density; a model without a density replaces the whole bank.
+    #[test]
+    fn inserting_replaces_the_same_sampling_and_adds_another() {
+        let mut bank = Bank(vec![model(3.0, Some([5.5, 6.8, 8.3]))]);
+        bank.insert(model(2.0, Some([2.8, 3.4, 4.2])));
+        assert_eq!(bank.0.len(), 2);
+        assert_eq!(bank.0[0].classifier.h1_ratio, 2.0);
+        bank.insert(model(3.5, Some([5.0, 7.0, 9.0])));
+        let ratios: Vec<f64> = bank.0.iter().map(|m| m.classifier.h1_ratio).collect();
+        assert_eq!(ratios, [2.0, 3.5]);
+        bank.insert(model(9.0, None));
+        assert_eq!(bank.0.len(), 1);
+        // A density-free model in the bank gives way to the first fit with a density.
+        bank.insert(model(2.5, Some([1.0, 2.0, 3.0])));
+        assert_eq!(bank.0.len(), 1);
+        assert_eq!(bank.0[0].classifier.h1_ratio, 2.5);
+    }
+
+    #[test]
+    fn density_of_windows_ignores_empty_ones() {
+        let d = Density::of(&[4.0, 0.0, 2.0, f64::NAN, 3.0]).unwrap();
+        assert_eq!((d.min, d.median, d.max), (2.0, 3.0, 4.0));
+        assert!(Density::of(&[0.0]).is_none());
+    }
+
+    /// A bank is one model object or an array; one model is written back as an object,
+    /// so model files written before banks existed load and round-trip unchanged.
+    #[test]
+    fn a_bank_reads_and_writes_both_json_forms() {
+        let one: Bank = serde_json::from_str(
+            r#"{"classifier": {"h0_ratio": 50, "h1_ratio": 2, "h1_span": 1}, "fitted_on": "x"}"#,
+        )
+        .unwrap();
+        assert_eq!(one.0.len(), 1);
+        assert!(one.0[0].events_per_point.is_none());
+        let text = serde_json::to_string(&one).unwrap();
+        assert!(text.starts_with('{') && !text.contains("events_per_point"));
+        let two = Bank(vec![
+            model(2.0, Some([2.8, 3.4, 4.2])),
+            model(3.0, Some([5.5, 6.8, 8.3])),
+        ]);
+        let text = serde_json::to_string(&two).unwrap();
+        assert!(text.starts_with('['));
+        assert_eq!(serde_json::from_str::<Bank>(&text).unwrap(), two);
+    }
+
+    fn load_text(text: &str) -> anyhow::Result<Models> {
+        let dir = std::env::temp_dir().join(format!("swarmmap-bank-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("{}.json", text.len()));
+        std::fs::write(&path, text).unwrap();
+        let r = Models::load(&path);
+        std::fs::remove_file(&path).ok();
+        r
+    }
+
+    #[test]
+    fn a_list_of_models_must_say_where_each_was_fitted() {
+        let mut m = Models::shipped();
+        m.embedded = Bank(vec![model(2.0, Some([2.8, 3.4, 4.2])), model(3.0, None)]);
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("Embedded") && err.contains("events_per_point"),
+            "{err}"
+        );
+        m.embedded = Bank(vec![model(2.0, Some([4.2, 3.4, 2.8]))]);
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("min ≤ median ≤ max"), "{err}");
+        m.embedded = Bank(Vec::new());
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("empty list"), "{err}");
+        m.embedded = Bank(vec![
+            model(2.0, Some([2.8, 3.4, 4.2])),
+            model(3.0, Some([5.5, 6.8, 8.3])),
+        ]);
+        let back = load_text(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(back, m);
     }
 }

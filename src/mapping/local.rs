@@ -24,7 +24,7 @@
 //! Cost per window: O(m · (n + E) log n) for the shortest paths, O(m²) memory for the
 //! metric, O(m · n) for the rows; never O(n²).
 
-use super::classify::{Classifier, sampling_scale};
+use super::classify::{Bank, Classifier, sampling_scale};
 use super::encounter_graph::{Bridging, EncounterGraph};
 use super::subsample::{SubsampleParams, subsample};
 use super::windows::Window;
@@ -54,8 +54,10 @@ pub struct LocalParams {
     pub min_component: usize,
     /// Smallest share of the window's encounters of a real component (default: `0.02`).
     pub min_share: f64,
-    /// The robust-feature classifier (default: the shipped model).
-    pub classifier: Classifier,
+    /// The robust-feature classifiers, one per sampling density (default: the shipped
+    /// models of the paper's method); each window is judged by the one fitted nearest its
+    /// [`LocalMap::events_per_point`].
+    pub classifier: Bank,
     /// Draw the representatives only from encounters with an agent that was a static
     /// landmark at the time (their position is that of the landmark, known exactly up to
     /// r_d), instead of from all encounters (default: `false`, the paper's choice).
@@ -82,7 +84,7 @@ impl Default for LocalParams {
             subsample: SubsampleParams::default(),
             min_component: 20,
             min_share: 0.02,
-            classifier: Classifier::default(),
+            classifier: Bank::single(Classifier::default()),
             anchored: false,
             witness: None,
             embedding_rips: None,
@@ -96,7 +98,7 @@ impl LocalParams {
     pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
-        p.classifier = super::classify::Models::active().get(m.method).classifier;
+        p.classifier = super::classify::Models::active().get(m.method).clone();
         p.bridging = Bridging::Paper;
         p.switch_cost = m.switch_cost;
         p.after_landmarks = m.after_landmarks;
@@ -169,6 +171,13 @@ pub struct LocalMap {
     pub betti: [usize; 2],
     /// Share of the MDS spectrum carried by the 3 kept dimensions (mean over components).
     pub explained: f64,
+    /// The window's sampling density: its real components' encounters per vertex of their
+    /// Rips complexes (0 when it has none). The classifier's thresholds are fitted at a
+    /// density ([`super::classify::Bank`]); this one picks the model the window is judged by.
+    pub events_per_point: f64,
+    /// The thresholds the window was judged by: the model of `LocalParams::classifier`
+    /// fitted nearest `events_per_point`.
+    pub classifier: Classifier,
     /// Distance rows from each component's representatives, kept for fidelity and
     /// stitching: `(event index, row over the window's events)`.
     #[serde(skip)]
@@ -291,6 +300,9 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         .filter(|g| g.len() >= min_size.max(3))
         .collect();
     let mapped: usize = groups.iter().map(Vec::len).sum();
+    // Each real component's diagram, vertices (as events) and vertex metric; classified
+    // once the window's density is known.
+    let mut raw = Vec::new();
     for members in groups {
         // A component with too few encounters with landmarks (a log without landmark
         // intervals, or a region no landmark reached) is embedded from all its encounters,
@@ -367,13 +379,27 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 (diagram, sub.picks.clone(), VertexMetric::Matrix(metric))
             }
         };
+        for &j in &members {
+            noise[j] = false;
+        }
+        rows_out.extend(sub.picks.iter().copied().zip(sub.rows));
+        raw.push((members, diagram, reps, vertex_metric));
+    }
+    let vertices: usize = raw.iter().map(|r| r.2.len()).sum();
+    let events_per_point = if vertices == 0 {
+        0.0
+    } else {
+        mapped as f64 / vertices as f64
+    };
+    let classifier = p.classifier.pick(events_per_point).classifier;
+    for (members, diagram, reps, vertex_metric) in raw {
         let features = super::classify::features(&diagram);
         let sigma = sampling_scale(&features);
         let mut betti = [0, 0];
         let mut bars = Vec::new();
         let mut holes = Vec::new();
         for (bar, f) in diagram.bars.iter().zip(&features) {
-            let robust = p.classifier.robust(f, sigma);
+            let robust = classifier.robust(f, sigma);
             if robust && f.dim < 2 {
                 betti[f.dim] += 1;
             }
@@ -409,10 +435,6 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 robust,
             });
         }
-        for &j in &members {
-            noise[j] = false;
-        }
-        rows_out.extend(sub.picks.iter().copied().zip(sub.rows));
         components.push(Component {
             events: members,
             representatives: reps,
@@ -440,6 +462,8 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         components,
         betti,
         explained,
+        events_per_point,
+        classifier,
         rows: rows_out,
     }
 }

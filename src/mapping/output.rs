@@ -113,6 +113,8 @@ struct WindowOut<'a> {
     betti: [usize; 2],
     truth: Option<[usize; 2]>,
     explained: f64,
+    /// The window's encounters per Rips vertex, which picked the classifier's model.
+    events_per_point: f64,
     /// The classifier's thresholds the diagrams were judged with (see `classify.rs`).
     classifier: Classifier,
     events: Vec<EventOut>,
@@ -120,13 +122,8 @@ struct WindowOut<'a> {
 }
 
 /// The JSON text of `maps/window_<i>.json`, with the thresholds of the classifier the
-/// diagrams were judged with (the report draws them).
-pub fn window_json(
-    map: &LocalMap,
-    log: &EncounterLog,
-    truth: Option<[usize; 2]>,
-    classifier: &Classifier,
-) -> String {
+/// diagrams were judged with (the report draws them) and the density that picked them.
+pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>) -> String {
     let events = map
         .events
         .iter()
@@ -152,7 +149,8 @@ pub fn window_json(
         betti: map.betti,
         truth,
         explained: map.explained,
-        classifier: *classifier,
+        events_per_point: map.events_per_point,
+        classifier: map.classifier,
         events,
         components: &map.components,
     };

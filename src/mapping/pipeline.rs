@@ -136,9 +136,13 @@ pub fn true_positions(map: &LocalMap, log: &EncounterLog) -> Option<Vec<[f64; 2]
         .collect()
 }
 
-/// (β0, β1) of the oracle: [`oracle_features`] judged by the shipped oracle model.
+/// (β0, β1) of the oracle: [`oracle_features`] judged by the oracle model fitted nearest
+/// the window's density (the oracle samples the same events with as many points).
 fn oracle_betti(map: &LocalMap, truth: &[[f64; 2]], rips_points: usize) -> [usize; 2] {
-    let classifier = super::classify::Models::active().oracle.classifier;
+    let classifier = super::classify::Models::active()
+        .oracle
+        .pick(map.events_per_point)
+        .classifier;
     let mut betti = [0, 0];
     for features in oracle_features(map, truth, rips_points) {
         let b = classifier.betti(&features);
@@ -237,6 +241,8 @@ mod oracle_tests {
             }],
             betti: [1, 0],
             explained: 1.0,
+            events_per_point: 1.0,
+            classifier: crate::mapping::classify::Classifier::default(),
             rows: Vec::new(),
         };
         (map, truth)

@@ -556,6 +556,8 @@ mod tests {
             }],
             betti: [1, 1],
             explained: 1.0,
+            events_per_point: 1.0,
+            classifier: crate::mapping::classify::Classifier::default(),
             rows: Vec::new(),
         }
     }
