@@ -329,8 +329,15 @@ fn eval_writes_one_row_per_run_and_resumes() {
 fn model_file(dir: &Path, name: &str, h1_ratio: f64, h1_span: f64) -> std::path::PathBuf {
     let mut m = json(Path::new("assets/classifier.json"));
     for method in ["Paper", "Embedded", "Oracle"] {
-        m[method]["classifier"]["h1_ratio"] = serde_json::json!(h1_ratio);
-        m[method]["classifier"]["h1_span"] = serde_json::json!(h1_span);
+        // An entry is one model or a bank of them (one per sampling density): set every one.
+        let models = match m[method].as_array_mut() {
+            Some(bank) => bank.iter_mut().collect::<Vec<_>>(),
+            None => vec![&mut m[method]],
+        };
+        for model in models {
+            model["classifier"]["h1_ratio"] = serde_json::json!(h1_ratio);
+            model["classifier"]["h1_span"] = serde_json::json!(h1_span);
+        }
     }
     let path = dir.join(name);
     fs::write(&path, serde_json::to_string_pretty(&m).unwrap()).unwrap();

@@ -19,7 +19,8 @@
 //! the default models in `assets/classifier.json`. σ makes them free of the metric's unit
 //! but not of the sampling: each model also records the density it was fitted at (encounters
 //! per vertex of the Rips complexes, [`Density`]), a method may carry several ([`Bank`]),
-//! and each window is judged by the one fitted nearest its own density.
+//! and each window is judged by the one fitted nearest its own density. The shipped file
+//! holds one model per method (README "Accuracy", step 31, says why).
 
 use serde::{Deserialize, Serialize};
 
@@ -74,7 +75,10 @@ pub struct Model {
 /// σ shrinks, and the model fitted at the sparser sampling shows false holes; a model
 /// fitted at the denser sampling asks for a life of 8.75 σ instead of 4.25 σ (README
 /// "Accuracy", step 28). A slower sweep with twice the points lands back at the sparser
-/// density, where the first model serves (step 29).
+/// density, where the first model serves (step 29). Density is not the whole regime,
+/// though: half-speed windows at 5–6 encounters per vertex are judged badly by the model
+/// fitted at that density at full speed (step 31), so a bank should hold models fitted at
+/// one sweep speed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Density {
