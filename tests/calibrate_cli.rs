@@ -9,8 +9,9 @@ use swarmmap::mapping::classify::{Models, SHIPPED};
 
 const WORLD: &str = "tests/fixtures/worlds/tiny.ron";
 
-fn calibrate(out: &std::path::Path, extra: &[&str]) {
-    Command::cargo_bin("swarmmap")
+/// Calibrates on the tiny world (seeds 1 and 2) into `out`; returns what it printed.
+fn calibrate(out: &std::path::Path, extra: &[&str]) -> String {
+    let assert = Command::cargo_bin("swarmmap")
         .unwrap()
         .args(["calibrate", WORLD, "--seeds", "1,2", "--jobs", "1", "--out"])
         .arg(out)
@@ -18,6 +19,7 @@ fn calibrate(out: &std::path::Path, extra: &[&str]) {
         .assert()
         .success()
         .stdout(contains("training windows 4"));
+    String::from_utf8_lossy(&assert.get_output().stdout).into_owned()
 }
 
 fn models(path: &std::path::Path) -> Models {
@@ -189,24 +191,14 @@ fn with_oracle_fits_both_entries_from_one_set_of_runs() {
     let out = dir.path().join("model.json");
     std::fs::write(&out, SHIPPED).unwrap();
     let shipped = Models::shipped();
-    Command::cargo_bin("swarmmap")
-        .unwrap()
-        .args([
-            "calibrate",
-            WORLD,
-            "--seeds",
-            "1,2",
-            "--jobs",
-            "1",
-            "--with-oracle",
-        ])
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success()
-        .stdout(contains("Paper: h0_ratio"))
-        .stdout(contains("Oracle: h0_ratio"))
-        .stdout(contains("encounters per Rips vertex"));
+    let stdout = calibrate(&out, &["--with-oracle"]);
+    for says in [
+        "Paper: h0_ratio",
+        "Oracle: h0_ratio",
+        "encounters per Rips vertex",
+    ] {
+        assert!(stdout.contains(says), "{stdout}");
+    }
     let m = models(&out);
     assert_eq!(m.embedded, shipped.embedded);
     for (bank, prefix) in [

@@ -558,4 +558,20 @@ mod tests {
         let back = load_text(&serde_json::to_string(&m).unwrap()).unwrap();
         assert_eq!(back, m);
     }
+
+    /// A fault inside a bank's list is reported at its own line, with what was expected
+    /// there (an untagged enum would report the entry's end and "did not match any variant").
+    #[test]
+    fn a_fault_inside_a_bank_keeps_its_place() {
+        let text = "{\n\"Paper\": [\n  {\"classifier\": 1}\n]\n}";
+        let e = serde_json::from_str::<Models>(text).unwrap_err();
+        assert_eq!(e.line(), 3, "{e}");
+        assert!(e.to_string().contains("invalid type: integer `1`"), "{e}");
+        let e = serde_json::from_str::<Models>("{\"Paper\": 7}").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("a model object or a list of model objects"),
+            "{e}"
+        );
+    }
 }
