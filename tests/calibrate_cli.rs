@@ -22,15 +22,21 @@ fn calibrate(out: &std::path::Path, extra: &[&str]) -> String {
     String::from_utf8_lossy(&assert.get_output().stdout).into_owned()
 }
 
+/// A temporary directory holding `model.json`, a copy of the shipped model file.
+fn shipped_copy() -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    std::fs::write(&out, SHIPPED).unwrap();
+    (dir, out)
+}
+
 fn models(path: &std::path::Path) -> Models {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]
 fn calibrate_replaces_only_the_fitted_entry() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("model.json");
-    std::fs::write(&out, SHIPPED).unwrap();
+    let (_dir, out) = shipped_copy();
     let shipped = Models::shipped();
 
     // tiny.ron maps with the paper's method: its entry is refitted, the others kept.
@@ -103,9 +109,7 @@ fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
 
 #[test]
 fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("model.json");
-    std::fs::write(&out, SHIPPED).unwrap();
+    let (_dir, out) = shipped_copy();
     let assert = Command::cargo_bin("swarmmap")
         .unwrap()
         .args(["calibrate", WORLD, "--seeds", "1,2", "--jobs", "1"])
@@ -140,10 +144,8 @@ fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
 
 #[test]
 fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("model.json");
+    let (dir, out) = shipped_copy();
     let land = dir.path().join("landscape.csv");
-    std::fs::write(&out, SHIPPED).unwrap();
     calibrate(
         &out,
         &[
@@ -187,9 +189,7 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
 /// records the density of its training windows.
 #[test]
 fn with_oracle_fits_both_entries_from_one_set_of_runs() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("model.json");
-    std::fs::write(&out, SHIPPED).unwrap();
+    let (_dir, out) = shipped_copy();
     let shipped = Models::shipped();
     let stdout = calibrate(&out, &["--with-oracle"]);
     for says in [
@@ -227,9 +227,7 @@ fn with_oracle_fits_both_entries_from_one_set_of_runs() {
 /// model that judged them.
 #[test]
 fn a_fit_at_another_density_joins_the_bank() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("model.json");
-    std::fs::write(&out, SHIPPED).unwrap();
+    let (dir, out) = shipped_copy();
     calibrate(&out, &[]);
     let dense = models(&out).paper.first().clone();
     calibrate(&out, &["--set", "mapping.subsample=50"]);

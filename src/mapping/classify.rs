@@ -159,20 +159,18 @@ impl Bank {
 
     /// The model a window of `events_per_point` encounters per Rips vertex is judged by.
     pub fn pick(&self, events_per_point: f64) -> &Model {
-        if self.0.len() > 1 && events_per_point.is_finite() && events_per_point > 0.0 {
-            let far = |m: &Model| {
-                m.events_per_point
-                    .map_or(f64::INFINITY, |d| (events_per_point / d.median).ln().abs())
-            };
-            let mut best = &self.0[0];
-            for m in &self.0[1..] {
-                if far(m) < far(best) {
-                    best = m;
-                }
-            }
-            return best;
+        if !(events_per_point.is_finite() && events_per_point > 0.0) {
+            return self.first();
         }
-        &self.0[0]
+        let far = |m: &Model| {
+            m.events_per_point
+                .map_or(f64::INFINITY, |d| (events_per_point / d.median).ln().abs())
+        };
+        // `min_by` keeps the first of equals: the first model on a tie.
+        self.0
+            .iter()
+            .min_by(|a, b| far(a).total_cmp(&far(b)))
+            .unwrap_or_else(|| self.first())
     }
 
     /// The first model (the only one of a bank of one).
@@ -521,13 +519,9 @@ mod tests {
     }
 
     fn load_text(text: &str) -> anyhow::Result<Models> {
-        let dir = std::env::temp_dir().join(format!("swarmmap-bank-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(format!("{}.json", text.len()));
-        std::fs::write(&path, text).unwrap();
-        let r = Models::load(&path);
-        std::fs::remove_file(&path).ok();
-        r
+        let file = tempfile::NamedTempFile::new().unwrap();
+        std::fs::write(file.path(), text).unwrap();
+        Models::load(file.path())
     }
 
     #[test]
