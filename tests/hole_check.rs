@@ -64,6 +64,7 @@ fn map_with(truth_len: usize, cycles: Vec<Vec<(usize, usize)>>) -> LocalMap {
                     void: None,
                 })
                 .collect(),
+            candidates: Vec::new(),
         }],
         betti: [1, 0],
         explained: 1.0,

@@ -158,7 +158,7 @@ pub fn check_global(
                 e.insert(crate::mapping::pipeline::true_positions(map, log)?)
             }
         };
-        let cycle = &map.components.get(c)?.holes.get(h)?.cycle;
+        let cycle = &map.components.get(c)?.mark(h)?.cycle;
         found.push(match encircled(truth, cycle, holes).as_slice() {
             [t] => Some(*t),
             _ => None,

@@ -359,7 +359,35 @@ pub fn sampling_scale(features: &[Feature]) -> f64 {
     d[d.len() / 2]
 }
 
+/// The candidate test's share of the H1 thresholds: a loop with `death / birth ≥ 0.85 ·
+/// h1_ratio` and `death − birth ≥ 0.75 · h1_span · σ` is a candidate, a hole that counts in
+/// the global map once a neighbouring window sees one at the same place
+/// ([`crate::mapping::stitch`]). Two windows see an obstacle of their overlap at different
+/// times, from different encounters, so their loops are two observations: each may be
+/// weaker than one window's alone must be (README "Accuracy", step 32).
+pub const CANDIDATE_SHARE: [f64; 2] = [0.85, 0.75];
+
+/// The strong test's multiple of `h1_span`: a robust hole that a neighbouring window
+/// covers without seeing any loop there stays a hole of the global map only when
+/// `death − birth ≥ 1.25 · h1_span · σ` ([`crate::mapping::stitch`]).
+pub const STRONG_SPAN: f64 = 1.25;
+
 impl Classifier {
+    /// The candidate test ([`CANDIDATE_SHARE`]) as a classifier; its H0 rule is this one's.
+    pub fn candidate(&self) -> Self {
+        Self {
+            h1_ratio: CANDIDATE_SHARE[0] * self.h1_ratio,
+            h1_span: CANDIDATE_SHARE[1] * self.h1_span,
+            ..*self
+        }
+    }
+
+    /// Whether a robust H1 class of life `death − birth` is strong on a diagram of sampling
+    /// scale `sigma` ([`STRONG_SPAN`]).
+    pub fn strong(&self, birth: f64, death: f64, sigma: f64) -> bool {
+        death - birth >= STRONG_SPAN * self.h1_span * sigma
+    }
+
     /// Whether each feature is robust, given the diagram's sampling scale `sigma`.
     pub fn robust(&self, f: &Feature, sigma: f64) -> bool {
         match f.dim {

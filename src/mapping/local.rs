@@ -120,6 +120,11 @@ pub struct MapBar {
     /// `null` in JSON for an essential class.
     pub death: Option<f64>,
     pub robust: bool,
+    /// For an H1 bar, the three representatives (indices into the window's `events`) of
+    /// the triangle whose entry kills it, as for [`Hole::void`]: where the loop's void lies,
+    /// robust or not (the global map weighs a hole two windows saw, `stitch`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub void: Option<[usize; 3]>,
 }
 
 /// A robust hole: its bar and a representative cycle as encounters (indices into the
@@ -151,6 +156,20 @@ pub struct Component {
     /// (β0, β1) of this component.
     pub betti: [usize; 2],
     pub holes: Vec<Hole>,
+    /// Loops too weak to be holes of this map alone but that pass the classifier's
+    /// candidate test ([`super::classify::Classifier::candidate`]): the global map counts
+    /// one when the previous or next window sees a loop at the same place (`stitch`).
+    pub candidates: Vec<Hole>,
+}
+
+impl Component {
+    /// Hole `h` of this component, counting its robust holes first and then its
+    /// candidates (the indexing of [`super::stitch::GlobalMap::holes`]).
+    pub fn mark(&self, h: usize) -> Option<&Hole> {
+        self.holes
+            .get(h)
+            .or_else(|| self.candidates.get(h.checked_sub(self.holes.len())?))
+    }
 }
 
 /// The local map of one window.
@@ -398,41 +417,50 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         let mut betti = [0, 0];
         let mut bars = Vec::new();
         let mut holes = Vec::new();
+        let candidate_rule = classifier.candidate();
+        // The loop that hugs the hole, not the engine's representative, which can run round
+        // most of the domain: the global map tells holes apart by their cycles (`stitch`),
+        // and the report draws them.
+        let hole = |bar: &crate::topology::rips::Bar, f: &super::classify::Feature| Hole {
+            birth: f.birth,
+            death: f.death,
+            cycle: bar
+                .cycle
+                .as_ref()
+                .map(|c| {
+                    let n = vertex_metric.len();
+                    let tight = tighten_cycle(n, |a, b| vertex_metric.dist(a, b), c);
+                    tight
+                        .as_deref()
+                        .unwrap_or(c)
+                        .iter()
+                        .map(|&(x, y)| (reps[x], reps[y]))
+                        .collect()
+                })
+                .unwrap_or_default(),
+            void: bar.death_triangle.map(|t| t.map(|x| reps[x])),
+        };
+        let mut candidates = Vec::new();
         for (bar, f) in diagram.bars.iter().zip(&features) {
             let robust = classifier.robust(f, sigma);
             if robust && f.dim < 2 {
                 betti[f.dim] += 1;
             }
             if robust && f.dim == 1 {
-                // The loop that hugs the hole, not the engine's representative, which can
-                // run round most of the domain: the global map tells holes apart by their
-                // cycles' times (`stitch`), and the report draws them.
-                let cycle = bar
-                    .cycle
-                    .as_ref()
-                    .map(|c| {
-                        let n = vertex_metric.len();
-                        let tight = tighten_cycle(n, |a, b| vertex_metric.dist(a, b), c);
-                        tight
-                            .as_deref()
-                            .unwrap_or(c)
-                            .iter()
-                            .map(|&(x, y)| (reps[x], reps[y]))
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                holes.push(Hole {
-                    birth: f.birth,
-                    death: f.death,
-                    cycle,
-                    void: bar.death_triangle.map(|t| t.map(|x| reps[x])),
-                });
+                holes.push(hole(bar, f));
+            } else if f.dim == 1 && candidate_rule.robust(f, sigma) {
+                candidates.push(hole(bar, f));
             }
             bars.push(MapBar {
                 dim: f.dim,
                 birth: f.birth,
                 death: f.death.is_finite().then_some(f.death),
                 robust,
+                void: if f.dim == 1 {
+                    bar.death_triangle.map(|t| t.map(|x| reps[x]))
+                } else {
+                    None
+                },
             });
         }
         components.push(Component {
@@ -442,6 +470,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
             diagram: bars,
             betti,
             holes,
+            candidates,
         });
     }
     let betti = components

@@ -238,6 +238,7 @@ mod oracle_tests {
                 diagram: Vec::new(),
                 betti: [1, 0],
                 holes: Vec::new(),
+                candidates: Vec::new(),
             }],
             betti: [1, 0],
             explained: 1.0,

@@ -25,7 +25,8 @@
 //!   long obstacle (scenario 2: one region splits into two branches around it and the
 //!   branches rejoin), enclose an obstacle that no single window saw whole. A hole that a
 //!   single window saw whole is a local hole; if it lies in the overlap of W_i and W_{i+1}
-//!   both maps report it, and the pair is counted once. Two local holes of consecutive maps
+//!   both maps report it, and the pair is counted once (which local holes count at all:
+//!   the next section). Two local holes of consecutive maps
 //!   are the same hole when, drawn on one plane, either one's cycle encircles the other's
 //!   void (the centroid of its death triangle). The plane: each map embeds its window on
 //!   its own (classical MDS fixes it only up to a similarity), but the events of the
@@ -42,6 +43,25 @@
 //!   depends on the sweep speed, and at half speed the cycles of one obstacle seen by
 //!   two windows missed each other by seconds (scenario 3 seed 5), while on the common
 //!   plane every pair that is one obstacle encircles and no pair of two does (step 30).
+//!
+//! # Holes two windows see, and holes one window sees alone (README "Accuracy", step 32)
+//!
+//! A window alone keeps a loop as a hole only when its persistence passes the classifier
+//! ([`crate::mapping::classify`]). But an obstacle in the overlap of two domains is seen by
+//! both windows, at different times and through different encounters: two observations
+//! of one place. So besides its robust holes each map offers its *candidates*, loops that
+//! pass a weaker test ([`crate::mapping::classify::Classifier::candidate`]), and the
+//! global map links the robust holes and candidates of consecutive maps that are the same
+//! place: voids within [`SAME_VOID`] σ on the common plane (or, two robust holes, either
+//! cycle round the other's void). A linked group two maps saw is one hole, whatever its
+//! members' strength: a weak loop in each of two windows is an obstacle both missed
+//! alone. A group one map saw is a hole when it is a robust hole and no neighbouring
+//! window covers its place ([`COVER`]: the obstacles at the arena's ends, or beyond the
+//! next domain), or when it is strong ([`crate::mapping::classify::Classifier::strong`]).
+//! A robust but not strong hole at a place the neighbour covers, where the neighbour's
+//! map holds encounters all round and no loop, is taken for noise of the one window.
+//! These evidences are independent because the two windows embed their encounters
+//! separately and share only the encounters of their time overlap.
 //!
 //! Why the terms do not double count: a hole wholly inside an overlap is inside both
 //! domains, so the overlap's free space around it is one corridor, one connection, and G
@@ -99,8 +119,9 @@ pub struct GlobalMap {
     pub nodes: Vec<(usize, usize)>,
     /// Edges between node indices, one per join.
     pub edges: Vec<(usize, usize)>,
-    /// Local holes after merging duplicates: `(window index, component, hole index)` of the
-    /// hole kept.
+    /// The distinct holes of the local maps: `(window index, component, hole)` of the one
+    /// kept for each, `hole` indexing the component's robust holes and then its candidates
+    /// ([`crate::mapping::local::Component::mark`]).
     pub holes: Vec<(usize, usize, usize)>,
     /// Cycle rank E − V + β0 of the gluing graph.
     pub gluing_cycles: usize,
@@ -362,6 +383,202 @@ fn same_hole(
     }
 }
 
+/// Two voids of consecutive maps, on a common plane, are one hole when they lie within
+/// this many sampling scales σ of each other (σ of the earlier map's component). Over
+/// scenario 3's seeds 1–20, the voids of one obstacle seen by two windows lie 0.3–15 σ
+/// apart (median 4), those of two obstacles 48 σ or more, and a noise loop's void lies
+/// within 19 σ of another window's loop in only 5 % of pairs (README "Accuracy", step 32).
+pub const SAME_VOID: f64 = 12.0;
+
+/// A neighbouring window covers a place of another map's plane when at least this share of
+/// its component's events lie within [`SAME_VOID`] σ of the place carried onto its own
+/// plane. An obstacle outside the neighbour's domain has none there; one inside it, a few
+/// per cent (step 32).
+pub const COVER: f64 = 0.01;
+
+/// One loop of a local map that the global map weighs: a robust hole or a candidate
+/// ([`crate::mapping::local::Component::mark`] indexing).
+#[derive(Debug, Clone, Copy)]
+struct Mark {
+    map: usize,
+    component: usize,
+    index: usize,
+    robust: bool,
+}
+
+impl Mark {
+    fn hole<'a>(&self, maps: &'a [LocalMap]) -> &'a Hole {
+        maps[self.map].components[self.component]
+            .mark(self.index)
+            .expect("marks index holes and candidates")
+    }
+}
+
+/// The centre of a hole's void on its map's plane (the death triangle's centroid; the
+/// cycle's vertices' centroid when the engine gave no death triangle).
+fn void_centre(map: &LocalMap, hole: &Hole) -> Option<[f64; 2]> {
+    let mut points: Vec<usize> = match hole.void {
+        Some(v) => v.to_vec(),
+        None => hole.cycle.iter().flat_map(|&(a, b)| [a, b]).collect(),
+    };
+    points.sort_unstable();
+    points.dedup();
+    if points.is_empty() {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (x, y) = points.iter().fold((0.0, 0.0), |(x, y), &j| {
+        (x + map.points[j][0], y + map.points[j][1])
+    });
+    Some([x / n, y / n])
+}
+
+/// The distinct holes of the global map, as marks of the local maps ([`GlobalMap::holes`]).
+///
+/// The marks of every map (its robust holes and its candidates) are linked to those of the
+/// next map that are the same hole: on the two components' common plane, when their voids
+/// lie within [`SAME_VOID`] σ, or (two robust holes) when either's cycle encircles the
+/// other's void ([`same_hole`]); without a common plane, by the times of their cycles. Each
+/// linked group is then one hole of the global map when
+/// - two maps saw it (their marks are two observations of one place: robust or candidate,
+///   each is evidence), or
+/// - one map saw it as a robust hole and no neighbouring map covers its place
+///   ([`COVER`]: an obstacle at the arena's end, or outside the other domains), or
+/// - one map saw it as a strong hole ([`crate::mapping::classify::Classifier::strong`]) though a neighbour that
+///   covers its place saw no loop there.
+///
+/// A robust hole that a neighbour covers but does not see, and that is not strong, is
+/// taken for noise: the neighbour's map holds the encounters round that place and no loop.
+/// The group's hole is its first robust mark (the first candidate if none is robust).
+fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usize)> {
+    let mut marks = Vec::new();
+    for (k, m) in maps.iter().enumerate() {
+        for (c, comp) in m.components.iter().enumerate() {
+            let robust = comp.holes.len();
+            for index in 0..robust + comp.candidates.len() {
+                marks.push(Mark {
+                    map: k,
+                    component: c,
+                    index,
+                    robust: index < robust,
+                });
+            }
+        }
+    }
+    let centres: Vec<Option<[f64; 2]>> = marks
+        .iter()
+        .map(|m| void_centre(&maps[m.map], m.hole(maps)))
+        .collect();
+    // Common planes, keyed (map of the pair's first, its component, the other's component):
+    // forward carries the later map onto the earlier, backward the earlier onto the later.
+    let mut forward: HashMap<(usize, usize, usize), Option<Similarity>> = HashMap::new();
+    let mut backward: HashMap<(usize, usize, usize), Option<Similarity>> = HashMap::new();
+    for k in 0..maps.len().saturating_sub(1) {
+        for a in 0..maps[k].components.len() {
+            for b in 0..maps[k + 1].components.len() {
+                forward.insert((k, a, b), common_plane(&maps[k], a, &maps[k + 1], b));
+                backward.insert((k, a, b), common_plane(&maps[k + 1], b, &maps[k], a));
+            }
+        }
+    }
+    let mut parent: Vec<usize> = (0..marks.len()).collect();
+    fn root(p: &mut [usize], x: usize) -> usize {
+        let mut r = x;
+        while p[r] != r {
+            r = p[r];
+        }
+        p[x] = r;
+        r
+    }
+    for (x, a) in marks.iter().enumerate() {
+        for (y, b) in marks.iter().enumerate() {
+            if b.map != a.map + 1 {
+                continue;
+            }
+            let (ma, mb) = (&maps[a.map], &maps[b.map]);
+            let plane = forward[&(a.map, a.component, b.component)].as_ref();
+            let near = match (plane, centres[x], centres[y]) {
+                (Some(f), Some(ca), Some(cb)) => {
+                    let q = f.apply(cb);
+                    let sigma = ma.components[a.component].scale;
+                    (q[0] - ca[0]).hypot(q[1] - ca[1]) <= SAME_VOID * sigma
+                }
+                _ => false,
+            };
+            let same = near
+                || (plane.is_none() || a.robust && b.robust)
+                    && same_hole((ma, a.hole(maps)), (mb, b.hole(maps)), plane, log);
+            if same {
+                let (ra, rb) = (root(&mut parent, x), root(&mut parent, y));
+                if ra != rb {
+                    parent[ra.max(rb)] = ra.min(rb);
+                }
+            }
+        }
+    }
+    // Whether map `k`'s neighbour `j` covers the place `at` of component `c` of map `k`.
+    let covers = |k: usize, c: usize, j: usize, at: [f64; 2]| {
+        let nb = &maps[j];
+        nb.components.iter().enumerate().any(|(cj, comp)| {
+            let plane = if j > k {
+                backward.get(&(k, c, cj))
+            } else {
+                forward.get(&(j, cj, c))
+            };
+            let Some(Some(f)) = plane else {
+                return false;
+            };
+            let q = f.apply(at);
+            let reach = SAME_VOID * comp.scale;
+            let near = comp
+                .events
+                .iter()
+                .filter(|&&e| (nb.points[e][0] - q[0]).hypot(nb.points[e][1] - q[1]) <= reach)
+                .count();
+            !comp.events.is_empty() && near as f64 >= COVER * comp.events.len() as f64
+        })
+    };
+    let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for x in 0..marks.len() {
+        groups.entry(root(&mut parent, x)).or_default().push(x);
+    }
+    let mut holes = Vec::new();
+    for members in groups.values() {
+        let first = members
+            .iter()
+            .copied()
+            .find(|&x| marks[x].robust)
+            .unwrap_or(members[0]);
+        let seen_by = members
+            .iter()
+            .map(|&x| marks[x].map)
+            .collect::<BTreeSet<_>>()
+            .len();
+        let kept = if seen_by >= 2 {
+            true
+        } else {
+            let m = marks[first];
+            let map = &maps[m.map];
+            let hole = m.hole(maps);
+            let sigma = map.components[m.component].scale;
+            let covered = centres[first].is_some_and(|at| {
+                [m.map.checked_sub(1), Some(m.map + 1)]
+                    .into_iter()
+                    .flatten()
+                    .filter(|&j| j < maps.len())
+                    .any(|j| covers(m.map, m.component, j, at))
+            });
+            m.robust && (!covered || map.classifier.strong(hole.birth, hole.death, sigma))
+        };
+        if kept {
+            let m = marks[first];
+            holes.push((maps[m.map].index, m.component, m.index));
+        }
+    }
+    holes.sort_unstable();
+    holes
+}
+
 /// Glues local maps through their connections into the global map.
 pub fn global_map(maps: &[LocalMap], connections: &[Connection], log: &EncounterLog) -> GlobalMap {
     let mut nodes = Vec::new();
@@ -408,32 +625,7 @@ pub fn global_map(maps: &[LocalMap], connections: &[Connection], log: &Encounter
         .filter(|&x| find(&mut parent, x) == x)
         .count();
     let gluing_cycles = (edges.len() + b0).saturating_sub(nodes.len());
-    // Local holes, merging a hole of M_{i+1} with one of M_i that is the same hole: its
-    // cycle encircles the other's void on the two maps' common plane
-    // ([`same_hole`]).
-    let mut holes: Vec<(usize, usize, usize)> = Vec::new();
-    let mut planes: HashMap<(usize, usize, usize), Option<Similarity>> = HashMap::new();
-    for (k, m) in maps.iter().enumerate() {
-        for (c, comp) in m.components.iter().enumerate() {
-            for (h, hole) in comp.holes.iter().enumerate() {
-                let duplicate = k > 0 && {
-                    let prev = &maps[k - 1];
-                    prev.components.iter().enumerate().any(|(pc, pcomp)| {
-                        let plane = *planes
-                            .entry((k, pc, c))
-                            .or_insert_with(|| common_plane(prev, pc, m, c));
-                        pcomp
-                            .holes
-                            .iter()
-                            .any(|ph| same_hole((prev, ph), (m, hole), plane.as_ref(), log))
-                    })
-                };
-                if !duplicate {
-                    holes.push((m.index, c, h));
-                }
-            }
-        }
-    }
+    let holes = global_holes(maps, log);
     GlobalMap {
         betti: [b0, gluing_cycles + holes.len()],
         nodes,
@@ -522,22 +714,41 @@ mod tests {
     }
 
     /// A map of window `index` holding the log's `events` at the plane points `at` (one
-    /// component), with one hole per loop of `loops` (indices into `events`).
+    /// component, sampling scale σ = 0.1), with one strong hole (life 10 σ) per loop of
+    /// `loops` (indices into `events`).
     fn planar_map(
         index: usize,
         events: Vec<usize>,
         at: Vec<[f64; 2]>,
         loops: &[Vec<usize>],
     ) -> LocalMap {
+        planar_map_with(index, events, at, loops, 2.0, &[])
+    }
+
+    /// A loop through `l` with life `death − 1`.
+    fn loop_hole(l: &[usize], death: f64) -> Hole {
+        Hole {
+            birth: 1.0,
+            death,
+            cycle: (0..l.len()).map(|k| (l[k], l[(k + 1) % l.len()])).collect(),
+            void: None,
+        }
+    }
+
+    /// [`planar_map`] whose holes die at `death` and which also holds a candidate per loop
+    /// of `weak`.
+    fn planar_map_with(
+        index: usize,
+        events: Vec<usize>,
+        at: Vec<[f64; 2]>,
+        loops: &[Vec<usize>],
+        death: f64,
+        weak: &[Vec<usize>],
+    ) -> LocalMap {
         let n = events.len();
         let holes = loops
             .iter()
-            .map(|l| Hole {
-                birth: 1.0,
-                death: 2.0,
-                cycle: (0..l.len()).map(|k| (l[k], l[(k + 1) % l.len()])).collect(),
-                void: None,
-            })
+            .map(|l| loop_hole(l, death))
             .collect::<Vec<_>>();
         LocalMap {
             index,
@@ -549,15 +760,22 @@ mod tests {
             components: vec![Component {
                 events: (0..n).collect(),
                 representatives: (0..n).collect(),
-                scale: 1.0,
+                scale: 0.1,
                 diagram: Vec::new(),
                 betti: [1, holes.len()],
                 holes,
+                candidates: weak.iter().map(|l| loop_hole(l, 1.5)).collect(),
             }],
             betti: [1, 1],
             explained: 1.0,
             events_per_point: 1.0,
-            classifier: crate::mapping::classify::Classifier::default(),
+            // The shipped Embedded model's thresholds: a hole is strong from a life of
+            // 1.25 · 4.25 · σ = 0.53.
+            classifier: crate::mapping::classify::Classifier {
+                h0_ratio: 57.5,
+                h1_ratio: 2.3,
+                h1_span: 4.25,
+            },
             rows: Vec::new(),
         }
     }
@@ -628,5 +846,95 @@ mod tests {
         );
         let elsewhere = second(60..70, [8.0, 0.0]);
         assert_eq!(global_map(&[first, elsewhere], joins, &log).betti, [1, 2]);
+    }
+
+    /// The log and the maps of the tests below: a lattice of events 0..40 that both maps
+    /// hold (t = 1 000–1 390; M_2's plane is M_1's turned and scaled), rings of ten events
+    /// each round the origin (40..50 in M_1, 50..60 in M_2) and round (30, 0) (60..70, in
+    /// M_1 only, outside M_2's lattice).
+    fn two_maps(
+        holes: [&[Vec<usize>]; 2],
+        weak: [&[Vec<usize>]; 2],
+        death: f64,
+    ) -> (EncounterLog, LocalMap, LocalMap) {
+        let times: Vec<f64> = (0..70).map(|k| 1000.0 + 10.0 * k as f64).collect();
+        let lattice: Vec<[f64; 2]> = (0..40)
+            .map(|k| [(k % 8) as f64 * 2.0 - 6.0, (k / 8) as f64 * 2.0 - 4.0])
+            .collect();
+        let ring = |c: [f64; 2]| -> Vec<[f64; 2]> {
+            (0..10)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / 10.0;
+                    [c[0] + a.cos(), c[1] + a.sin()]
+                })
+                .collect()
+        };
+        let other = |p: [f64; 2]| [-2.0 * p[1] + 1.0, 2.0 * p[0] - 3.0];
+        let first = planar_map_with(
+            1,
+            (0..50).chain(60..70).collect(),
+            lattice
+                .iter()
+                .copied()
+                .chain(ring([0.0, 0.0]))
+                .chain(ring([30.0, 0.0]))
+                .collect(),
+            holes[0],
+            death,
+            weak[0],
+        );
+        let second = planar_map_with(
+            2,
+            (0..40).chain(50..60).collect(),
+            lattice
+                .iter()
+                .copied()
+                .chain(ring([0.0, 0.0]))
+                .map(other)
+                .collect(),
+            holes[1],
+            death,
+            weak[1],
+        );
+        (log(&times), first, second)
+    }
+
+    /// Two candidates (loops too weak for either map alone) that two windows see round
+    /// one place are one hole of the global map; one candidate alone is none.
+    #[test]
+    fn a_loop_two_windows_see_weakly_is_one_hole() {
+        let join = one_join();
+        let joins = std::slice::from_ref(&join);
+        let round_origin_1 = vec![(40..50).collect::<Vec<_>>()];
+        let round_origin_2 = vec![(40..50).collect::<Vec<_>>()];
+        let (log, m1, m2) = two_maps([&[], &[]], [&round_origin_1, &round_origin_2], 2.0);
+        let g = global_map(&[m1, m2], joins, &log);
+        assert_eq!(g.betti, [1, 1]);
+        // The hole kept is M_1's candidate, indexed after its (no) robust holes.
+        assert_eq!(g.holes, vec![(1, 0, 0)]);
+        let (log, m1, m2) = two_maps([&[], &[]], [&round_origin_1, &[]], 2.0);
+        assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 0]);
+    }
+
+    /// A robust hole that the next window covers (its lattice lies round the place) but
+    /// sees no loop at is noise unless it is strong; one the next window does not cover
+    /// stands on its own.
+    #[test]
+    fn a_hole_the_neighbour_covers_without_a_loop_must_be_strong() {
+        let join = one_join();
+        let joins = std::slice::from_ref(&join);
+        let round_origin = vec![(40..50).collect::<Vec<_>>()];
+        let far = vec![(50..60).collect::<Vec<_>>()];
+        // σ = 0.1 and h1_span 4.25: strong from a life of 0.53.
+        let weak_life = 1.0 + 0.4;
+        let (log, m1, m2) = two_maps([&round_origin, &[]], [&[], &[]], weak_life);
+        assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 0]);
+        let (log, m1, m2) = two_maps([&round_origin, &[]], [&[], &[]], 2.0);
+        assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 1]);
+        let (log, m1, m2) = two_maps([&far, &[]], [&[], &[]], weak_life);
+        assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 1]);
+        // A candidate of M_2 round the origin confirms M_1's weak hole.
+        let (log, m1, m2) = two_maps([&round_origin, &[]], [&[], &round_origin], weak_life);
+        assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 1]);
     }
 }

@@ -55,6 +55,20 @@ pub struct ComponentIn {
     pub diagram: Vec<BarIn>,
     pub betti: [usize; 2],
     pub holes: Vec<HoleIn>,
+    /// Loops the global map may count when a neighbour sees one too (absent in maps
+    /// written before candidates existed).
+    #[serde(default)]
+    pub candidates: Vec<HoleIn>,
+}
+
+impl ComponentIn {
+    /// Hole `h` counting the robust holes first, then the candidates (the indexing of
+    /// `global.json`'s `holes`).
+    pub fn mark(&self, h: usize) -> Option<&HoleIn> {
+        self.holes
+            .get(h)
+            .or_else(|| self.candidates.get(h.checked_sub(self.holes.len())?))
+    }
 }
 
 /// `maps/window_<i>.json`.
@@ -205,7 +219,7 @@ fn check_window(path: &Path, w: &WindowIn) -> Result<(), ReportError> {
                 format!("component {c} lists event {j}, but the window has {n} events"),
             ));
         }
-        for hole in &comp.holes {
+        for hole in comp.holes.iter().chain(&comp.candidates) {
             if let Some(&j) = hole.void.iter().flatten().find(|&&j| j >= n) {
                 return Err(invalid(
                     path,

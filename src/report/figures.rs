@@ -974,7 +974,7 @@ pub fn global(run: &RunData) -> Result<Figure, ReportError> {
         let Some(w) = run.windows.iter().find(|w| w.index == wi) else {
             continue;
         };
-        let Some(hole) = w.components.get(c).and_then(|comp| comp.holes.get(h)) else {
+        let Some(hole) = w.components.get(c).and_then(|comp| comp.mark(h)) else {
             continue;
         };
         let mut times: Vec<f64> = hole
