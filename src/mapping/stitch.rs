@@ -780,6 +780,23 @@ mod tests {
         }
     }
 
+    /// 40 events on a lattice of spacing 2: x −6..8, y −4..4.
+    fn lattice() -> Vec<[f64; 2]> {
+        (0..40)
+            .map(|k| [(k % 8) as f64 * 2.0 - 6.0, (k / 8) as f64 * 2.0 - 4.0])
+            .collect()
+    }
+
+    /// Ten events on a circle of radius `r` round `c`.
+    fn ring(c: [f64; 2], r: f64) -> Vec<[f64; 2]> {
+        (0..10)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 10.0;
+                [c[0] + r * a.cos(), c[1] + r * a.sin()]
+            })
+            .collect()
+    }
+
     /// Two maps that share events are compared on a common plane: M_2's plane is M_1's
     /// reflected, turned, scaled and moved, and a hole of M_2 drawn round the same place
     /// as M_1's hole is that hole even though the times of their cycles are far apart
@@ -795,17 +812,7 @@ mod tests {
         times.extend((0..10).map(|k| 2000.0 + 10.0 * k as f64));
         times.extend((0..10).map(|k| 150.0 + 10.0 * k as f64));
         let log = log(&times);
-        let lattice: Vec<[f64; 2]> = (0..40)
-            .map(|k| [(k % 8) as f64 * 2.0 - 6.0, (k / 8) as f64 * 2.0 - 4.0])
-            .collect();
-        let ring = |c: [f64; 2], r: f64| -> Vec<[f64; 2]> {
-            (0..10)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * k as f64 / 10.0;
-                    [c[0] + r * a.cos(), c[1] + r * a.sin()]
-                })
-                .collect()
-        };
+        let lattice = lattice();
         // M_2's plane: x ↦ 3 · R(40°) · (x, −y) + (5, −2).
         let (c, s) = (40f64.to_radians().cos(), 40f64.to_radians().sin());
         let other = |p: [f64; 2]| {
@@ -858,17 +865,7 @@ mod tests {
         death: f64,
     ) -> (EncounterLog, LocalMap, LocalMap) {
         let times: Vec<f64> = (0..70).map(|k| 1000.0 + 10.0 * k as f64).collect();
-        let lattice: Vec<[f64; 2]> = (0..40)
-            .map(|k| [(k % 8) as f64 * 2.0 - 6.0, (k / 8) as f64 * 2.0 - 4.0])
-            .collect();
-        let ring = |c: [f64; 2]| -> Vec<[f64; 2]> {
-            (0..10)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * k as f64 / 10.0;
-                    [c[0] + a.cos(), c[1] + a.sin()]
-                })
-                .collect()
-        };
+        let lattice = lattice();
         let other = |p: [f64; 2]| [-2.0 * p[1] + 1.0, 2.0 * p[0] - 3.0];
         let first = planar_map_with(
             1,
@@ -876,8 +873,8 @@ mod tests {
             lattice
                 .iter()
                 .copied()
-                .chain(ring([0.0, 0.0]))
-                .chain(ring([30.0, 0.0]))
+                .chain(ring([0.0, 0.0], 1.0))
+                .chain(ring([30.0, 0.0], 1.0))
                 .collect(),
             holes[0],
             death,
@@ -889,7 +886,7 @@ mod tests {
             lattice
                 .iter()
                 .copied()
-                .chain(ring([0.0, 0.0]))
+                .chain(ring([0.0, 0.0], 1.0))
                 .map(other)
                 .collect(),
             holes[1],

@@ -34,7 +34,8 @@ pub struct BarIn {
     pub robust: bool,
 }
 
-/// A robust hole and its representative cycle (pairs of indices into the window's events).
+/// A robust hole or a candidate, and its representative cycle (pairs of indices into the
+/// window's events).
 #[derive(Debug, Clone, Deserialize)]
 pub struct HoleIn {
     pub birth: f64,
@@ -448,4 +449,29 @@ pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
         log,
         trajectories,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `global.json` indexes a component's robust holes and then its candidates; a map
+    /// written before candidates existed reads as having none.
+    #[test]
+    fn a_global_hole_indexes_holes_then_candidates() {
+        let hole = |birth: f64| format!(r#"{{"birth": {birth}, "death": 9.0, "cycle": [[0, 1]]}}"#);
+        let text = format!(
+            r#"{{"events": [0, 1], "scale": 1.0, "diagram": [], "betti": [1, 1],
+                "holes": [{}], "candidates": [{}, {}]}}"#,
+            hole(1.0),
+            hole(2.0),
+            hole(3.0)
+        );
+        let c: ComponentIn = serde_json::from_str(&text).unwrap();
+        let births: Vec<Option<f64>> = (0..4).map(|h| c.mark(h).map(|x| x.birth)).collect();
+        assert_eq!(births, vec![Some(1.0), Some(2.0), Some(3.0), None]);
+        let old = r#"{"events": [], "scale": 1.0, "diagram": [], "betti": [1, 0], "holes": []}"#;
+        let c: ComponentIn = serde_json::from_str(old).unwrap();
+        assert!(c.candidates.is_empty() && c.mark(0).is_none());
+    }
 }
