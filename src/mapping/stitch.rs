@@ -60,8 +60,8 @@
 //! next domain), or when it is strong ([`crate::mapping::classify::Classifier::strong`]).
 //! A robust but not strong hole at a place the neighbour covers, where the neighbour's
 //! map holds encounters all round and no loop, is taken for noise of the one window.
-//! These evidences are independent because the two windows embed their encounters
-//! separately and share only the encounters of their time overlap.
+//! The two observations are largely independent: the two windows embed their
+//! encounters separately and share only the encounters of their time overlap.
 //!
 //! Why the terms do not double count: a hole wholly inside an overlap is inside both
 //! domains, so the overlap's free space around it is one corridor, one connection, and G
@@ -335,15 +335,8 @@ fn drawn(map: &LocalMap, hole: &Hole, place: impl Fn([f64; 2]) -> [f64; 2]) -> O
     if edges.is_empty() {
         return None;
     }
-    let mean = |ps: &[[f64; 2]]| {
-        let n = ps.len() as f64;
-        let (x, y) = ps.iter().fold((0.0, 0.0), |(x, y), p| (x + p[0], y + p[1]));
-        [x / n, y / n]
-    };
-    let centre = match hole.void {
-        Some(v) => mean(&v.map(at)),
-        None => mean(&points),
-    };
+    // A similarity carries the mean of points to the mean of their images.
+    let centre = place(void_centre(map, hole)?);
     Some(Drawn {
         points,
         edges,
