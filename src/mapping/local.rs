@@ -166,10 +166,16 @@ impl Component {
     /// Hole `h` of this component, counting its robust holes first and then its
     /// candidates (the indexing of [`super::stitch::GlobalMap::holes`]).
     pub fn mark(&self, h: usize) -> Option<&Hole> {
-        self.holes
-            .get(h)
-            .or_else(|| self.candidates.get(h.checked_sub(self.holes.len())?))
+        mark(&self.holes, &self.candidates, h)
     }
+}
+
+/// Item `h` of `holes` followed by `candidates`: how [`super::stitch::GlobalMap::holes`]
+/// indexes a component's loops, in memory and as read back from `maps/`.
+pub fn mark<'a, H>(holes: &'a [H], candidates: &'a [H], h: usize) -> Option<&'a H> {
+    holes
+        .get(h)
+        .or_else(|| candidates.get(h.checked_sub(holes.len())?))
 }
 
 /// The local map of one window.

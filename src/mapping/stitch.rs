@@ -75,7 +75,7 @@ use crate::eval::holes::encircles;
 use crate::eval::{Similarity, procrustes};
 use crate::log::{AgentId, EncounterLog, StaticReason};
 use crate::topology::DistanceMatrix;
-use crate::topology::linkage::single_linkage;
+use crate::topology::linkage::{UnionFind, single_linkage};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -462,35 +462,23 @@ fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usi
         .iter()
         .map(|m| void_centre(&maps[m.map], m.hole(maps)))
         .collect();
-    // Common planes, keyed (map of the pair's first, its component, the other's component):
-    // forward carries the later map onto the earlier, backward the earlier onto the later.
-    let mut forward: HashMap<(usize, usize, usize), Option<Similarity>> = HashMap::new();
-    let mut backward: HashMap<(usize, usize, usize), Option<Similarity>> = HashMap::new();
-    for k in 0..maps.len().saturating_sub(1) {
-        for a in 0..maps[k].components.len() {
-            for b in 0..maps[k + 1].components.len() {
-                forward.insert((k, a, b), common_plane(&maps[k], a, &maps[k + 1], b));
-                backward.insert((k, a, b), common_plane(&maps[k + 1], b, &maps[k], a));
-            }
-        }
-    }
-    let mut parent: Vec<usize> = (0..marks.len()).collect();
-    fn root(p: &mut [usize], x: usize) -> usize {
-        let mut r = x;
-        while p[r] != r {
-            r = p[r];
-        }
-        p[x] = r;
-        r
-    }
+    // Common planes, fitted when first needed: (map, component) carried onto (map,
+    // component).
+    let mut planes: HashMap<[usize; 4], Option<Similarity>> = HashMap::new();
+    let mut plane = |(k, c): (usize, usize), (j, cj): (usize, usize)| {
+        *planes
+            .entry([k, c, j, cj])
+            .or_insert_with(|| common_plane(&maps[j], cj, &maps[k], c))
+    };
+    let mut sets = UnionFind::new(marks.len());
     for (x, a) in marks.iter().enumerate() {
         for (y, b) in marks.iter().enumerate() {
             if b.map != a.map + 1 {
                 continue;
             }
             let (ma, mb) = (&maps[a.map], &maps[b.map]);
-            let plane = forward[&(a.map, a.component, b.component)].as_ref();
-            let near = match (plane, centres[x], centres[y]) {
+            let onto_a = plane((b.map, b.component), (a.map, a.component));
+            let near = match (onto_a, centres[x], centres[y]) {
                 (Some(f), Some(ca), Some(cb)) => {
                     let q = f.apply(cb);
                     let sigma = ma.components[a.component].scale;
@@ -499,28 +487,21 @@ fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usi
                 _ => false,
             };
             let same = near
-                || (plane.is_none() || a.robust && b.robust)
-                    && same_hole((ma, a.hole(maps)), (mb, b.hole(maps)), plane, log);
+                || (onto_a.is_none() || a.robust && b.robust)
+                    && same_hole((ma, a.hole(maps)), (mb, b.hole(maps)), onto_a.as_ref(), log);
             if same {
-                let (ra, rb) = (root(&mut parent, x), root(&mut parent, y));
-                if ra != rb {
-                    parent[ra.max(rb)] = ra.min(rb);
-                }
+                sets.union(x, y);
             }
         }
     }
-    // Whether map `k`'s neighbour `j` covers the place `at` of component `c` of map `k`.
-    let covers = |k: usize, c: usize, j: usize, at: [f64; 2]| {
+    // Whether map `j` covers the place `at` of component `c` of map `k`.
+    let mut covers = |k: usize, c: usize, j: usize, at: [f64; 2]| {
         let nb = &maps[j];
-        nb.components.iter().enumerate().any(|(cj, comp)| {
-            let plane = if j > k {
-                backward.get(&(k, c, cj))
-            } else {
-                forward.get(&(j, cj, c))
-            };
-            let Some(Some(f)) = plane else {
+        (0..nb.components.len()).any(|cj| {
+            let Some(f) = plane((k, c), (j, cj)) else {
                 return false;
             };
+            let comp = &nb.components[cj];
             let q = f.apply(at);
             let reach = SAME_VOID * comp.scale;
             let near = comp
@@ -533,7 +514,7 @@ fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usi
     };
     let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for x in 0..marks.len() {
-        groups.entry(root(&mut parent, x)).or_default().push(x);
+        groups.entry(sets.find(x)).or_default().push(x);
     }
     let mut holes = Vec::new();
     for members in groups.values() {
@@ -594,29 +575,11 @@ pub fn global_map(maps: &[LocalMap], connections: &[Connection], log: &Encounter
         }
     }
     // β0 by union–find over the gluing graph.
-    let mut parent: Vec<usize> = (0..nodes.len()).collect();
-    fn find(p: &mut [usize], x: usize) -> usize {
-        let mut r = x;
-        while p[r] != r {
-            r = p[r];
-        }
-        let mut y = x;
-        while p[y] != r {
-            let next = p[y];
-            p[y] = r;
-            y = next;
-        }
-        r
-    }
+    let mut sets = UnionFind::new(nodes.len());
     for &(a, b) in &edges {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
-        }
+        sets.union(a, b);
     }
-    let b0 = (0..nodes.len())
-        .filter(|&x| find(&mut parent, x) == x)
-        .count();
+    let b0 = (0..nodes.len()).filter(|&x| sets.find(x) == x).count();
     let gluing_cycles = (edges.len() + b0).saturating_sub(nodes.len());
     let holes = global_holes(maps, log);
     GlobalMap {

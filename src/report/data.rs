@@ -66,9 +66,7 @@ impl ComponentIn {
     /// Hole `h` counting the robust holes first, then the candidates (the indexing of
     /// `global.json`'s `holes`).
     pub fn mark(&self, h: usize) -> Option<&HoleIn> {
-        self.holes
-            .get(h)
-            .or_else(|| self.candidates.get(h.checked_sub(self.holes.len())?))
+        crate::mapping::local::mark(&self.holes, &self.candidates, h)
     }
 }
 

@@ -65,20 +65,20 @@ pub enum LinkageError {
 }
 
 /// Disjoint sets over `0..n` with path halving and union by size.
-struct UnionFind {
+pub(crate) struct UnionFind {
     parent: Vec<usize>,
     size: Vec<usize>,
 }
 
 impl UnionFind {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Self {
             parent: (0..n).collect(),
             size: vec![1; n],
         }
     }
 
-    fn find(&mut self, mut x: usize) -> usize {
+    pub(crate) fn find(&mut self, mut x: usize) -> usize {
         while self.parent[x] != x {
             self.parent[x] = self.parent[self.parent[x]];
             x = self.parent[x];
@@ -87,7 +87,7 @@ impl UnionFind {
     }
 
     /// Joins the sets of `x` and `y`; returns the new root, or `None` if already joined.
-    fn union(&mut self, x: usize, y: usize) -> Option<usize> {
+    pub(crate) fn union(&mut self, x: usize, y: usize) -> Option<usize> {
         let (mut rx, mut ry) = (self.find(x), self.find(y));
         if rx == ry {
             return None;
