@@ -201,12 +201,18 @@ fn with_oracle_fits_both_entries_from_one_set_of_runs() {
     }
     let m = models(&out);
     assert_eq!(m.embedded, shipped.embedded);
-    for (bank, prefix) in [
-        (&m.paper, "swarmmap calibrate --seeds 1,2 "),
-        (&m.oracle, "swarmmap calibrate --oracle --seeds 1,2 "),
+    for (bank, shipped, prefix) in [
+        (&m.paper, &shipped.paper, "swarmmap calibrate --seeds 1,2 "),
+        (
+            &m.oracle,
+            &shipped.oracle,
+            "swarmmap calibrate --oracle --seeds 1,2 ",
+        ),
     ] {
-        assert_eq!(bank.0.len(), 1, "the density-free shipped model gives way");
-        let fit = bank.first();
+        // The fit joins the shipped model, which was fitted at another sweep.
+        assert_eq!(bank.0.len(), 2, "{bank:?}");
+        assert_eq!(bank.for_sweep(0.005), *shipped);
+        let fit = &bank.for_sweep(TINY_SWEEP).0[0];
         assert!(fit.fitted_on.starts_with(prefix), "{}", fit.fitted_on);
         let d = fit.events_per_point.expect("the density is recorded");
         assert!(
@@ -216,8 +222,8 @@ fn with_oracle_fits_both_entries_from_one_set_of_runs() {
     }
     // The oracle samples the same events with as many points: the same density.
     assert_eq!(
-        m.paper.first().events_per_point,
-        m.oracle.first().events_per_point
+        m.paper.for_sweep(TINY_SWEEP).first().events_per_point,
+        m.oracle.for_sweep(TINY_SWEEP).first().events_per_point
     );
 }
 
@@ -225,31 +231,48 @@ fn with_oracle_fits_both_entries_from_one_set_of_runs() {
 /// encounters per Rips vertex) joins the bank; a refit at the first sampling replaces its
 /// model; `--only` leaves one model. Maps made with the bank record the density and the
 /// model that judged them.
+/// tiny.ron's leader sweeps at 0.02 m/s: its fits are the models of that sweep.
+const TINY_SWEEP: f64 = 0.02;
+
 #[test]
 fn a_fit_at_another_density_joins_the_bank() {
     let (dir, out) = shipped_copy();
+    let shipped = Models::shipped().paper;
+    // The models of tiny's sweep, and those of every other sweep.
+    let at_tiny = |m: &Models| m.paper.for_sweep(TINY_SWEEP).0;
+    let others = |m: &Models| -> Vec<_> {
+        m.paper
+            .0
+            .iter()
+            .filter(|x| x.sweep() != TINY_SWEEP)
+            .cloned()
+            .collect()
+    };
     calibrate(&out, &[]);
-    let dense = models(&out).paper.first().clone();
+    let dense = at_tiny(&models(&out))[0].clone();
     calibrate(&out, &["--set", "mapping.subsample=50"]);
     let m = models(&out);
-    assert_eq!(m.paper.0.len(), 2, "{:?}", m.paper);
+    assert_eq!(at_tiny(&m).len(), 2, "{:?}", m.paper);
     assert_eq!(
-        m.paper.0[0], dense,
+        at_tiny(&m)[0],
+        dense,
         "ordered by density, the denser sampling first"
     );
-    let sparse = m.paper.0[1].clone();
+    let sparse = at_tiny(&m)[1].clone();
     assert!(sparse.fitted_on.contains("--set mapping.subsample=50 "));
     assert!(sparse.events_per_point.unwrap().median > 2.0 * dense.events_per_point.unwrap().median);
     calibrate(&out, &[]);
-    assert_eq!(models(&out).paper.0, vec![dense.clone(), sparse.clone()]);
+    assert_eq!(at_tiny(&models(&out)), vec![dense.clone(), sparse.clone()]);
     calibrate(&out, &["--only"]);
-    let only = models(&out).paper;
-    assert_eq!(only.0.len(), 1);
+    let only = at_tiny(&models(&out));
+    assert_eq!(only.len(), 1);
     assert!(
-        only.first()
+        only[0]
             .fitted_on
             .starts_with("swarmmap calibrate --only --seeds 1,2 ")
     );
+    // The shipped model, fitted at another sweep, stays through all of these.
+    assert_eq!(others(&models(&out)), shipped.0);
 
     // A run mapped with a two-model bank records each window's density and the model of
     // the nearest one.
@@ -276,4 +299,65 @@ fn a_fit_at_another_density_joins_the_bank() {
         assert_eq!(w["classifier"]["h1_ratio"], ratio, "subsample {sub}");
         assert!(w["events_per_point"].as_f64().unwrap() > 1.0);
     }
+}
+
+/// A fit records the sweep of its training runs and joins the shipped model of another
+/// sweep; a run is judged by the models of the sweep nearest its leader's, whatever their
+/// densities.
+#[test]
+fn a_run_is_judged_by_the_models_of_its_sweep() {
+    let (dir, out) = shipped_copy();
+    calibrate(&out, &[]);
+    let mut m = models(&out);
+    assert_eq!(m.paper.0.len(), 2, "{:?}", m.paper);
+    let fitted = m.paper.for_sweep(TINY_SWEEP).0;
+    assert_eq!(fitted.len(), 1);
+    assert_eq!(fitted[0].leader_speed, Some(TINY_SWEEP));
+    // Mark the two models apart by an H1 ratio no data reaches.
+    for x in &mut m.paper.0 {
+        if x.sweep() == TINY_SWEEP {
+            x.classifier.h1_ratio = 1e9;
+        } else {
+            x.classifier.h1_ratio = 2e9;
+        }
+    }
+    let model = dir.path().join("sweeps.json");
+    std::fs::write(&model, serde_json::to_string(&m).unwrap()).unwrap();
+    let run = dir.path().join("run");
+    for (speed, ratio) in [("0.02", 1e9), ("0.03", 1e9), ("0.006", 2e9)] {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .arg("--model")
+            .arg(&model)
+            .args(["run", WORLD, "--seed", "1", "--no-report", "--set"])
+            .arg(format!("leader.speed={speed}"))
+            .arg("--out")
+            .arg(&run)
+            .assert()
+            .success();
+        let w: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.join("maps/window_1.json")).unwrap())
+                .unwrap();
+        assert_eq!(w["classifier"]["h1_ratio"], ratio, "leader speed {speed}");
+    }
+}
+
+/// Training worlds that sweep at different speeds would give a model of no one sweep.
+#[test]
+fn training_worlds_of_different_sweeps_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let fast = dir.path().join("fast.ron");
+    let text = std::fs::read_to_string(WORLD).unwrap();
+    std::fs::write(&fast, text.replace("speed: 0.02,", "speed: 0.04,")).unwrap();
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args(["calibrate", WORLD])
+        .arg(&fast)
+        .args(["--seeds", "1", "--jobs", "1", "--out"])
+        .arg(dir.path().join("m.json"))
+        .assert()
+        .code(2)
+        .stderr(contains("sweep at different speeds"))
+        .stderr(contains("--set leader.speed="));
+    assert!(!dir.path().join("m.json").exists());
 }

@@ -36,7 +36,8 @@ pub struct CalibrateArgs {
     /// method's bank, a refit at the same sampling replaces it. Other methods are kept.
     #[arg(long, default_value = "assets/classifier.json")]
     pub out: PathBuf,
-    /// Make the fitted model the method's only one, whatever the densities of the others.
+    /// Make the fitted model the method's only one at its sweep speed, whatever the
+    /// densities of the others (models fitted at other sweeps stay).
     #[arg(long)]
     pub only: bool,
     /// Fit the truth-position oracle's model instead (the `Embedded` topology stage on the
@@ -119,6 +120,22 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         .iter()
         .map(|p| load_world(p, &args.set))
         .collect::<Result<_, _>>()?;
+    // A model is tied to one sweep speed (`Bank::for_sweep`): the training runs share it.
+    let sweep = worlds[0].leader.speed;
+    if let Some((w, p)) = worlds
+        .iter()
+        .zip(&paths)
+        .find(|(w, _)| w.leader.speed != sweep)
+    {
+        return Err(input(anyhow!(
+            "the training worlds sweep at different speeds ({}: {} m/s, {}: {} m/s); a model \
+             is fitted at one sweep: give them one with --set leader.speed=V",
+            paths[0].display(),
+            sweep,
+            p.display(),
+            w.leader.speed
+        )));
+    }
     let jobs: Vec<(&World, u64)> = worlds
         .iter()
         .flat_map(|w| seeds.iter().map(move |&s| (w, s)))
@@ -326,9 +343,10 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             classifier: f.classifier,
             fitted_on,
             events_per_point: density,
+            leader_speed: Some(sweep),
         };
         if args.only {
-            bank.0 = vec![model];
+            bank.replace_sweep(model);
         } else {
             bank.insert(model);
         }

@@ -113,7 +113,12 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             .as_ref()
             .map_or_else(MappingParams::default, |w| w.mapping.clone());
         m.method = method.into();
-        cfg.local = LocalParams::from_mapping(&m);
+        let sweep = world
+            .as_ref()
+            .map_or(swarmmap::mapping::classify::DEFAULT_SWEEP, |w| {
+                w.leader.speed
+            });
+        cfg.local = LocalParams::from_mapping_at(&m, sweep);
     }
     if !log
         .static_intervals

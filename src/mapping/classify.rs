@@ -63,6 +63,22 @@ pub struct Model {
     /// written before densities were recorded, which serve every window.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub events_per_point: Option<Density>,
+    /// The leader's sweep speed of its training runs, m/s ([`Bank::for_sweep`]); `None` in
+    /// model files written before sweeps were recorded, which count as fitted at the
+    /// default sweep ([`DEFAULT_SWEEP`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leader_speed: Option<f64>,
+}
+
+/// The sweep a model without a recorded `leader_speed` was fitted at: the default leader
+/// speed, that of every training world.
+pub const DEFAULT_SWEEP: f64 = 0.005;
+
+impl Model {
+    /// The leader speed its training runs swept at, m/s.
+    pub fn sweep(&self) -> f64 {
+        self.leader_speed.unwrap_or(DEFAULT_SWEEP)
+    }
 }
 
 /// Encounters per vertex of the Rips complexes over a model's training windows
@@ -108,10 +124,16 @@ impl Density {
     }
 }
 
-/// The models of one method, each fitted at its own sampling density. A window is judged
-/// by the model whose training windows' median density is nearest its own, as a ratio
-/// (|ln d − ln median|; the first on a tie). In JSON a bank is one model object, or an
-/// array of them, each with its `events_per_point`.
+/// The models of one method, each fitted at its own sweep speed and sampling density. A
+/// run keeps the models fitted at the sweep nearest its leader's ([`Bank::for_sweep`]), and
+/// each of its windows is judged by the one of them whose training windows' median density
+/// is nearest its own, as a ratio (|ln d − ln median|; the first on a tie). In JSON a bank
+/// is one model object, or an array of them, each with its `events_per_point`.
+///
+/// Why the sweep comes first: a slower sweep keeps the swarm longer round each part of the
+/// arena, and windows of the same density then hold loops of another kind (README
+/// "Accuracy", step 31: half-speed windows at the density of a full-speed model are judged
+/// badly by it), so density alone cannot tell which model fits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bank(pub Vec<Model>);
 
@@ -154,7 +176,39 @@ impl Bank {
             classifier,
             fitted_on: String::new(),
             events_per_point: None,
+            leader_speed: None,
         }])
+    }
+
+    /// The models fitted at the sweep nearest `speed` (m/s), as a ratio (|ln v − ln s|; on a
+    /// tie the faster sweep). A speed that is not positive and finite counts as the default.
+    pub fn for_sweep(&self, speed: f64) -> Bank {
+        let speed = if speed.is_finite() && speed > 0.0 {
+            speed
+        } else {
+            DEFAULT_SWEEP
+        };
+        let far = |s: f64| (speed / s).ln().abs();
+        let Some(best) = self.0.iter().map(Model::sweep).reduce(|a, b| {
+            let (fa, fb) = (far(a), far(b));
+            // Within rounding of a tie (0.0025 between 0.005 and 0.00125): the faster.
+            if (fa - fb).abs() <= 1e-9 {
+                a.max(b)
+            } else if fb < fa {
+                b
+            } else {
+                a
+            }
+        }) else {
+            return self.clone();
+        };
+        Bank(
+            self.0
+                .iter()
+                .filter(|m| m.sweep() == best)
+                .cloned()
+                .collect(),
+        )
     }
 
     /// The model a window of `events_per_point` encounters per Rips vertex is judged by.
@@ -178,21 +232,38 @@ impl Bank {
         &self.0[0]
     }
 
-    /// Puts `model` in the bank: it replaces every model whose median density lies within
-    /// its training range (or every model, if either side has no recorded density), and
-    /// joins the others, the bank kept in order of median density.
+    /// Puts `model` in the bank: among the models of its sweep it replaces every one whose
+    /// median density lies within its training range (or every one, if either side has no
+    /// recorded density), and joins the others; models of other sweeps stay. The bank is
+    /// kept in order of sweep, fastest first, then of median density.
     pub fn insert(&mut self, model: Model) {
+        let sweep = model.sweep();
         match model.events_per_point {
-            None => self.0.clear(),
+            None => self.0.retain(|m| m.sweep() != sweep),
             Some(d) => self.0.retain(|m| {
-                m.events_per_point
-                    .is_some_and(|e| e.median < d.min || e.median > d.max)
+                m.sweep() != sweep
+                    || m.events_per_point
+                        .is_some_and(|e| e.median < d.min || e.median > d.max)
             }),
         }
         self.0.push(model);
+        self.sort();
+    }
+
+    /// Keeps only `model` among the models of its sweep (`calibrate --only`).
+    pub fn replace_sweep(&mut self, model: Model) {
+        let sweep = model.sweep();
+        self.0.retain(|m| m.sweep() != sweep);
+        self.0.push(model);
+        self.sort();
+    }
+
+    fn sort(&mut self) {
         self.0.sort_by(|a, b| {
             let key = |m: &Model| m.events_per_point.map_or(0.0, |d| d.median);
-            key(a).total_cmp(&key(b))
+            b.sweep()
+                .total_cmp(&a.sweep())
+                .then(key(a).total_cmp(&key(b)))
         });
     }
 }
@@ -233,7 +304,8 @@ impl Models {
                  --out FILE` writes: an object with \"Paper\", \"Embedded\" and \"Oracle\" \
                  entries, each a model {{\"classifier\": {{\"h0_ratio\", \"h1_ratio\", \
                  \"h1_span\"}}, \"fitted_on\"}} or a list of models that also carry \
-                 \"events_per_point\": {{\"min\", \"median\", \"max\"}} (see assets/classifier.json)",
+                 \"events_per_point\": {{\"min\", \"median\", \"max\"}}, and may carry \
+                 \"leader_speed\" (m/s, the sweep they were fitted at; see assets/classifier.json)",
                 path.display(),
                 e.line(),
                 e.column()
@@ -250,14 +322,19 @@ impl Models {
                     path.display()
                 );
             }
-            if bank.0.len() > 1 && bank.0.iter().any(|m| m.events_per_point.is_none()) {
-                anyhow::bail!(
-                    "{}: the {name} entry lists {} models but not every one has \
-                     \"events_per_point\" ({{\"min\", \"median\", \"max\"}}), which picks the \
-                     model of each window; a list needs it on every model (calibrate writes it)",
-                    path.display(),
-                    bank.0.len()
-                );
+            for m in &bank.0 {
+                let same = bank.for_sweep(m.sweep());
+                if same.0.len() > 1 && same.0.iter().any(|m| m.events_per_point.is_none()) {
+                    anyhow::bail!(
+                        "{}: the {name} entry lists {} models fitted at the sweep of {} m/s but \
+                         not every one has \"events_per_point\" ({{\"min\", \"median\", \
+                         \"max\"}}), which picks the model of each window among them; models \
+                         of one sweep need it on every one (calibrate writes it)",
+                        path.display(),
+                        same.0.len(),
+                        m.sweep()
+                    );
+                }
             }
             for m in &bank.0 {
                 let c = m.classifier;
@@ -276,6 +353,16 @@ impl Models {
                         c.h0_ratio,
                         c.h1_ratio,
                         c.h1_span
+                    );
+                }
+                if let Some(v) = m.leader_speed
+                    && !(v.is_finite() && v > 0.0)
+                {
+                    anyhow::bail!(
+                        "{}: the {name} model's leader_speed is {v}; it is the sweep speed of \
+                         its training runs in m/s, positive and finite (or leave it out for the \
+                         default sweep, {DEFAULT_SWEEP} m/s)",
+                        path.display()
                     );
                 }
                 if let Some(d) = m.events_per_point {
@@ -472,6 +559,7 @@ mod tests {
             },
             fitted_on: format!("ratio {h1_ratio}"),
             events_per_point: density.map(|[min, median, max]| Density { min, median, max }),
+            leader_speed: None,
         }
     }
 
@@ -516,6 +604,61 @@ mod tests {
         bank.insert(model(2.5, Some([1.0, 2.0, 3.0])));
         assert_eq!(bank.0.len(), 1);
         assert_eq!(bank.0[0].classifier.h1_ratio, 2.5);
+    }
+
+    fn swept(h1_ratio: f64, density: [f64; 3], sweep: Option<f64>) -> Model {
+        Model {
+            leader_speed: sweep,
+            ..model(h1_ratio, Some(density))
+        }
+    }
+
+    /// A run keeps the models of the sweep nearest its leader's, as a ratio; a model
+    /// without a recorded sweep counts as fitted at the default; on a tie the faster sweep
+    /// wins; density then picks among the kept models only.
+    #[test]
+    fn a_run_takes_the_models_of_the_nearest_sweep() {
+        let bank = Bank(vec![
+            swept(2.0, [5.0, 6.0, 7.0], None),
+            swept(3.0, [2.8, 3.4, 4.2], Some(DEFAULT_SWEEP)),
+            swept(5.0, [5.5, 6.3, 7.0], Some(0.00125)),
+        ]);
+        let ratios = |speed: f64| -> Vec<f64> {
+            let b = bank.for_sweep(speed);
+            b.0.iter().map(|m| m.classifier.h1_ratio).collect()
+        };
+        assert_eq!(ratios(0.005), [2.0, 3.0]);
+        assert_eq!(ratios(0.01), [2.0, 3.0]);
+        assert_eq!(ratios(0.001), [5.0]);
+        assert_eq!(ratios(0.0015), [5.0]);
+        // 0.0025 is a factor 2 from both: the faster sweep.
+        assert_eq!(ratios(0.0025), [2.0, 3.0]);
+        assert_eq!(ratios(0.0024), [5.0]);
+        // Not a speed: the default sweep.
+        assert_eq!(ratios(0.0), [2.0, 3.0]);
+        assert_eq!(ratios(f64::NAN), [2.0, 3.0]);
+        // At the same density, the sweep decides.
+        assert_eq!(bank.for_sweep(0.00125).pick(6.0).classifier.h1_ratio, 5.0);
+        assert_eq!(bank.for_sweep(0.005).pick(6.3).classifier.h1_ratio, 2.0);
+    }
+
+    /// A fit at another sweep joins the bank whatever its density; a refit at a sweep
+    /// replaces only that sweep's models of its density, and `--only` only that sweep's.
+    #[test]
+    fn inserting_keeps_the_models_of_other_sweeps() {
+        let mut bank = Bank(vec![swept(2.3, [5.5, 6.8, 8.3], None)]);
+        bank.insert(swept(4.0, [5.0, 6.5, 8.0], Some(0.00125)));
+        let ratios = |b: &Bank| -> Vec<f64> { b.0.iter().map(|m| m.classifier.h1_ratio).collect() };
+        assert_eq!(ratios(&bank), [2.3, 4.0]);
+        bank.insert(swept(4.5, [6.0, 6.6, 7.0], Some(0.00125)));
+        assert_eq!(ratios(&bank), [2.3, 4.5]);
+        bank.insert(swept(3.0, [2.8, 3.4, 4.2], Some(DEFAULT_SWEEP)));
+        // Fastest sweep first, then density.
+        assert_eq!(ratios(&bank), [3.0, 2.3, 4.5]);
+        bank.replace_sweep(swept(4.9, [1.0, 2.0, 3.0], Some(0.00125)));
+        assert_eq!(ratios(&bank), [3.0, 2.3, 4.9]);
+        bank.replace_sweep(swept(2.0, [1.0, 2.0, 3.0], None));
+        assert_eq!(ratios(&bank), [2.0, 4.9]);
     }
 
     #[test]
@@ -579,6 +722,19 @@ mod tests {
         ]);
         let back = load_text(&serde_json::to_string(&m).unwrap()).unwrap();
         assert_eq!(back, m);
+        // Density picks among the models of one sweep only: a density-free model of
+        // another sweep may stand beside them.
+        m.embedded
+            .0
+            .push(swept(4.0, [1.0, 1.0, 1.0], Some(0.00125)));
+        m.embedded.0[2].events_per_point = None;
+        let back = load_text(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(back, m);
+        m.embedded.0[2].leader_speed = Some(0.0);
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("leader_speed is 0"), "{err}");
     }
 
     /// A fault inside a bank's list is reported at its own line, with what was expected

@@ -94,11 +94,21 @@ impl Default for LocalParams {
 }
 
 impl LocalParams {
-    /// The parameters a world's `mapping` section selects.
+    /// The parameters a world's `mapping` section selects, with the models fitted at the
+    /// default sweep ([`super::classify::DEFAULT_SWEEP`]; a log without a world).
     pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
+        Self::from_mapping_at(m, super::classify::DEFAULT_SWEEP)
+    }
+
+    /// The parameters a world's `mapping` section selects for a leader sweeping at `sweep`
+    /// m/s: the models of the method fitted at the nearest sweep
+    /// ([`super::classify::Bank::for_sweep`]).
+    pub fn from_mapping_at(m: &crate::world::MappingParams, sweep: f64) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
-        p.classifier = super::classify::Models::active().get(m.method).clone();
+        p.classifier = super::classify::Models::active()
+            .get(m.method)
+            .for_sweep(sweep);
         p.bridging = Bridging::Paper;
         p.switch_cost = m.switch_cost;
         p.after_landmarks = m.after_landmarks;

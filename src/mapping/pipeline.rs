@@ -32,7 +32,7 @@ impl MapConfig {
             windows: world.mapping.windows,
             overlap: world.mapping.overlap,
             span: (0.0, world.total_duration()),
-            local: LocalParams::from_mapping(&world.mapping),
+            local: LocalParams::from_mapping_at(&world.mapping, world.leader.speed),
         }
     }
 
