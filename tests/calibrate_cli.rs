@@ -34,6 +34,30 @@ fn models(path: &std::path::Path) -> Models {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// Runs the tiny world (seed 1) with the models of `model` and one `--set`, in `dir/run`;
+/// returns its first window's `maps/window_1.json`.
+fn first_window(model: &std::path::Path, set: &str, dir: &std::path::Path) -> serde_json::Value {
+    let run = dir.join("run");
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .arg("--model")
+        .arg(model)
+        .args([
+            "run",
+            WORLD,
+            "--seed",
+            "1",
+            "--no-report",
+            "--set",
+            set,
+            "--out",
+        ])
+        .arg(&run)
+        .assert()
+        .success();
+    serde_json::from_str(&std::fs::read_to_string(run.join("maps/window_1.json")).unwrap()).unwrap()
+}
+
 #[test]
 fn calibrate_replaces_only_the_fitted_entry() {
     let (_dir, out) = shipped_copy();
@@ -281,21 +305,8 @@ fn a_fit_at_another_density_joins_the_bank() {
     bank.paper.0[1].classifier.h1_ratio = 1e9;
     let model = dir.path().join("bank.json");
     std::fs::write(&model, serde_json::to_string(&bank).unwrap()).unwrap();
-    let run = dir.path().join("run");
     for (sub, ratio) in [("150", dense.classifier.h1_ratio), ("50", 1e9)] {
-        Command::cargo_bin("swarmmap")
-            .unwrap()
-            .arg("--model")
-            .arg(&model)
-            .args(["run", WORLD, "--seed", "1", "--no-report", "--set"])
-            .arg(format!("mapping.subsample={sub}"))
-            .arg("--out")
-            .arg(&run)
-            .assert()
-            .success();
-        let w: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(run.join("maps/window_1.json")).unwrap())
-                .unwrap();
+        let w = first_window(&model, &format!("mapping.subsample={sub}"), dir.path());
         assert_eq!(w["classifier"]["h1_ratio"], ratio, "subsample {sub}");
         assert!(w["events_per_point"].as_f64().unwrap() > 1.0);
     }
@@ -323,21 +334,8 @@ fn a_run_is_judged_by_the_models_of_its_sweep() {
     }
     let model = dir.path().join("sweeps.json");
     std::fs::write(&model, serde_json::to_string(&m).unwrap()).unwrap();
-    let run = dir.path().join("run");
     for (speed, ratio) in [("0.02", 1e9), ("0.03", 1e9), ("0.006", 2e9)] {
-        Command::cargo_bin("swarmmap")
-            .unwrap()
-            .arg("--model")
-            .arg(&model)
-            .args(["run", WORLD, "--seed", "1", "--no-report", "--set"])
-            .arg(format!("leader.speed={speed}"))
-            .arg("--out")
-            .arg(&run)
-            .assert()
-            .success();
-        let w: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(run.join("maps/window_1.json")).unwrap())
-                .unwrap();
+        let w = first_window(&model, &format!("leader.speed={speed}"), dir.path());
         assert_eq!(w["classifier"]["h1_ratio"], ratio, "leader speed {speed}");
     }
 }
