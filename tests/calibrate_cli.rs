@@ -359,3 +359,46 @@ fn training_worlds_of_different_sweeps_are_refused() {
         .stderr(contains("--set leader.speed="));
     assert!(!dir.path().join("m.json").exists());
 }
+
+/// `--runs DIR` keeps each training run's diagrams; a second fit reuses them (no new
+/// simulation) and writes the same model, essential classes included; an unreadable file
+/// is run again.
+#[test]
+fn runs_kept_with_runs_dir_are_reused_and_fit_the_same_model() {
+    let (dir, out) = shipped_copy();
+    let runs = dir.path().join("runs");
+    let first = calibrate(&out, &["--runs", runs.to_str().unwrap()]);
+    let fitted = std::fs::read_to_string(&out).unwrap();
+    let mut files: Vec<_> = std::fs::read_dir(&runs)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 2, "one file per seed: {files:?}");
+    std::fs::write(&out, SHIPPED).unwrap();
+    let assert = Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args([
+            "calibrate",
+            WORLD,
+            "--seeds",
+            "1,2",
+            "--jobs",
+            "1",
+            "--runs",
+        ])
+        .arg(&runs)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let stderr = String::from_utf8_lossy(&assert.get_output().stderr).into_owned();
+    assert_eq!(stderr.matches("reused from").count(), 2, "{stderr}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), fitted);
+    // A damaged file is not trusted: that run is simulated again.
+    std::fs::write(&files[0], "{ not json").unwrap();
+    std::fs::write(&out, SHIPPED).unwrap();
+    let again = calibrate(&out, &["--runs", runs.to_str().unwrap()]);
+    assert_eq!(again, first);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), fitted);
+}

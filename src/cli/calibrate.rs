@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit, h1_landscape};
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
-use swarmmap::mapping::classify::{Density, Model, Models};
+use swarmmap::mapping::classify::{Density, Feature, Model, Models};
 use swarmmap::mapping::pipeline::{MapConfig, map_windows, oracle_features, true_positions};
 use swarmmap::sim::{SimOptions, simulate};
 use swarmmap::world::{MappingMethod, World};
@@ -62,6 +62,104 @@ pub struct CalibrateArgs {
     /// the optimum is and which other rules score nearly as well.
     #[arg(long, value_name = "CSV")]
     pub landscape: Option<PathBuf>,
+    /// Keep each finished training run's diagrams in DIR (one JSON file per world, `--set`
+    /// values and seed) and reuse them on a later call, so an interrupted or extended fit
+    /// (more seeds, another cap, cross-validation) does not simulate them again. Delete DIR
+    /// after changing swarmmap's mapping code: the files hold its output.
+    #[arg(long, value_name = "DIR")]
+    pub runs: Option<PathBuf>,
+}
+
+/// One training run as `--runs` keeps it: per fit it fed, its windows' features, truths
+/// and densities. Numbers are kept as their `f64` bits, so that a reused run fits exactly
+/// the model a fresh one does (decimal JSON need not read back the same last bit); a death
+/// of `None` is an essential class (JSON has no infinity).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredRun {
+    world: String,
+    seed: u64,
+    fits: Vec<StoredFit>,
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredFit {
+    oracle: bool,
+    densities: Vec<u64>,
+    windows: Vec<StoredWindow>,
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredWindow {
+    truth: [usize; 2],
+    /// Per component: `(dim, birth, death)`.
+    components: Vec<Vec<(usize, u64, Option<u64>)>>,
+}
+
+impl StoredWindow {
+    fn from_sample(s: &Sample) -> Self {
+        Self {
+            truth: s.truth,
+            components: s
+                .components
+                .iter()
+                .map(|c| {
+                    c.iter()
+                        .map(|f| {
+                            let death = f.death.is_finite().then_some(f.death.to_bits());
+                            (f.dim, f.birth.to_bits(), death)
+                        })
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    fn sample(&self) -> Sample {
+        Sample {
+            truth: self.truth,
+            components: self
+                .components
+                .iter()
+                .map(|c| {
+                    c.iter()
+                        .map(|&(dim, birth, death)| Feature {
+                            dim,
+                            birth: f64::from_bits(birth),
+                            death: death.map_or(f64::INFINITY, f64::from_bits),
+                        })
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The file of one training run in `--runs DIR`: it changes with the world's text, the
+/// `--set` values, the fits the run feeds and the seed.
+fn stored_path(
+    dir: &std::path::Path,
+    path: &std::path::Path,
+    set: &[String],
+    targets: &[bool],
+    seed: u64,
+) -> Option<PathBuf> {
+    use sha2::{Digest, Sha256};
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut h = Sha256::new();
+    h.update(text.as_bytes());
+    for s in set {
+        h.update(s.as_bytes());
+        h.update([0]);
+    }
+    for &t in targets {
+        h.update([u8::from(t)]);
+    }
+    let hex: String = h.finalize()[..6]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("world");
+    Some(dir.join(format!("{stem}-{hex}-s{seed}.json")))
 }
 
 /// How `--cross-validate` groups the training windows into folds.
@@ -136,10 +234,16 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             w.leader.speed
         )));
     }
-    let jobs: Vec<(&World, u64)> = worlds
+    let jobs: Vec<(&World, &PathBuf, u64)> = worlds
         .iter()
-        .flat_map(|w| seeds.iter().map(move |&s| (w, s)))
+        .zip(&paths)
+        .flat_map(|(w, p)| seeds.iter().map(move |&s| (w, p, s)))
         .collect();
+    if let Some(dir) = &args.runs {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the --runs directory {}", dir.display()))
+            .map_err(input)?;
+    }
     let threads = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -159,7 +263,35 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     type Job = Vec<(Target, Vec<Sample>, Vec<f64>, String, u64)>;
     let results: Vec<Result<Job, String>> = pool.install(|| {
         jobs.par_iter()
-            .map(|&(world, seed)| {
+            .map(|&(world, path, seed)| {
+                let stored = args
+                    .runs
+                    .as_deref()
+                    .and_then(|dir| stored_path(dir, path, &args.set, &targets, seed));
+                if let Some(file) = &stored
+                    && let Ok(text) = std::fs::read_to_string(file)
+                    && let Ok(run) = serde_json::from_str::<StoredRun>(&text)
+                {
+                    eprintln!(
+                        "calibrate: {} seed {seed} reused from {}",
+                        world.name,
+                        file.display()
+                    );
+                    return Ok(run
+                        .fits
+                        .into_iter()
+                        .map(|f| {
+                            let target = if f.oracle {
+                                Target::Oracle
+                            } else {
+                                Target::Method(world.mapping.method)
+                            };
+                            let samples = f.windows.iter().map(StoredWindow::sample).collect();
+                            let densities = f.densities.into_iter().map(f64::from_bits).collect();
+                            (target, samples, densities, world.name.clone(), seed)
+                        })
+                        .collect());
+                }
                 let out = simulate(world, &SimOptions::new(seed))
                     .map_err(|e| format!("{} seed {seed}: {e}", world.name))?;
                 let cfg = MapConfig::for_world(world);
@@ -176,7 +308,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     .collect();
                 let mut fits = Vec::new();
                 for &for_oracle in &targets {
-                    let samples = maps
+                    let samples: Vec<Sample> = maps
                         .iter()
                         .zip(&truths)
                         .map(|(m, &truth)| {
@@ -202,6 +334,24 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                         Target::Method(world.mapping.method)
                     };
                     fits.push((target, samples, densities.clone(), world.name.clone(), seed));
+                }
+                if let Some(file) = &stored {
+                    let run = StoredRun {
+                        world: world.name.clone(),
+                        seed,
+                        fits: fits
+                            .iter()
+                            .map(|(target, samples, densities, _, _)| StoredFit {
+                                oracle: matches!(target, Target::Oracle),
+                                densities: densities.iter().map(|d| d.to_bits()).collect(),
+                                windows: samples.iter().map(StoredWindow::from_sample).collect(),
+                            })
+                            .collect(),
+                    };
+                    let mut bytes = serde_json::to_vec(&run).map_err(|e| e.to_string())?;
+                    bytes.push(b'\n');
+                    write_atomic(file, &bytes)
+                        .map_err(|e| format!("writing {}: {e}", file.display()))?;
                 }
                 eprintln!("calibrate: {} seed {seed} done", world.name);
                 Ok(fits)
