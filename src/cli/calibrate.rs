@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use std::path::PathBuf;
 use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit, h1_landscape};
+use swarmmap::eval::campaign::run_key;
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::{Density, Feature, Model, Models};
@@ -134,34 +135,6 @@ impl StoredWindow {
     }
 }
 
-/// The file of one training run in `--runs DIR`: it changes with the world's text, the
-/// `--set` values, the fits the run feeds and the seed.
-fn stored_path(
-    dir: &std::path::Path,
-    path: &std::path::Path,
-    set: &[String],
-    targets: &[bool],
-    seed: u64,
-) -> Option<PathBuf> {
-    use sha2::{Digest, Sha256};
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut h = Sha256::new();
-    h.update(text.as_bytes());
-    for s in set {
-        h.update(s.as_bytes());
-        h.update([0]);
-    }
-    for &t in targets {
-        h.update([u8::from(t)]);
-    }
-    let hex: String = h.finalize()[..6]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("world");
-    Some(dir.join(format!("{stem}-{hex}-s{seed}.json")))
-}
-
 /// How `--cross-validate` groups the training windows into folds.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CvGroups {
@@ -234,15 +207,43 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             w.leader.speed
         )));
     }
-    let jobs: Vec<(&World, &PathBuf, u64)> = worlds
-        .iter()
-        .zip(&paths)
-        .flat_map(|(w, p)| seeds.iter().map(move |&s| (w, p, s)))
-        .collect();
-    if let Some(dir) = &args.runs {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the --runs directory {}", dir.display()))
-            .map_err(input)?;
+    // The fits each run feeds: the method's, the oracle's, or both.
+    let oracle = args.oracle;
+    let mut targets = Vec::new();
+    if !oracle {
+        targets.push(false);
+    }
+    if oracle || args.with_oracle {
+        targets.push(true);
+    }
+    // With `--runs DIR`, each job's file there: it changes with the world's text, the
+    // `--set` values, the fits the run feeds and the seed.
+    let mut jobs: Vec<(&World, u64, Option<PathBuf>)> = Vec::new();
+    for (world, path) in worlds.iter().zip(&paths) {
+        let key_parts = match &args.runs {
+            None => None,
+            Some(dir) => {
+                std::fs::create_dir_all(dir)
+                    .with_context(|| format!("creating the --runs directory {}", dir.display()))
+                    .map_err(input)?;
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("reading {}", path.display()))
+                    .map_err(input)?;
+                let mut parts = text.into_bytes();
+                for s in &args.set {
+                    parts.extend_from_slice(s.as_bytes());
+                    parts.push(0);
+                }
+                parts.extend(targets.iter().map(|&t| u8::from(t)));
+                Some((dir, parts))
+            }
+        };
+        for &seed in &seeds {
+            let stored = key_parts
+                .as_ref()
+                .map(|(dir, parts)| dir.join(format!("{}.json", run_key(path, &[parts], seed))));
+            jobs.push((world, seed, stored));
+        }
     }
     let threads = args
         .jobs
@@ -251,24 +252,12 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         .num_threads(threads.max(1))
         .build()
         .map_err(|e| Failure::Other(e.into()))?;
-    let oracle = args.oracle;
-    // The fits each run feeds: the method's, the oracle's, or both.
-    let mut targets = Vec::new();
-    if !oracle {
-        targets.push(false);
-    }
-    if oracle || args.with_oracle {
-        targets.push(true);
-    }
     type Job = Vec<(Target, Vec<Sample>, Vec<f64>, String, u64)>;
     let results: Vec<Result<Job, String>> = pool.install(|| {
         jobs.par_iter()
-            .map(|&(world, path, seed)| {
-                let stored = args
-                    .runs
-                    .as_deref()
-                    .and_then(|dir| stored_path(dir, path, &args.set, &targets, seed));
-                if let Some(file) = &stored
+            .map(|(world, seed, stored)| {
+                let (world, seed) = (*world, *seed);
+                if let Some(file) = stored
                     && let Ok(text) = std::fs::read_to_string(file)
                     && let Ok(run) = serde_json::from_str::<StoredRun>(&text)
                 {
@@ -335,7 +324,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     };
                     fits.push((target, samples, densities.clone(), world.name.clone(), seed));
                 }
-                if let Some(file) = &stored {
+                if let Some(file) = stored {
                     let run = StoredRun {
                         world: world.name.clone(),
                         seed,

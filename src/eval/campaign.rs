@@ -37,18 +37,29 @@ impl Job {
 
     /// A file-name key that changes with the world's text, the overrides and the seed.
     pub fn key(&self, world_text: &str) -> String {
-        let mut h = Sha256::new();
-        h.update(world_text.as_bytes());
-        h.update(self.params().as_bytes());
-        let digest = h.finalize();
-        let hex: String = digest[..6].iter().map(|b| format!("{b:02x}")).collect();
-        let stem = self
-            .world
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("world");
-        format!("{stem}-{hex}-s{}", self.seed)
+        run_key(
+            &self.world,
+            &[world_text.as_bytes(), self.params().as_bytes()],
+            self.seed,
+        )
     }
+}
+
+/// A stored run's file-name key, `<world stem>-<12 hex digits>-s<seed>`: the hex digits are
+/// the start of the SHA-256 of `parts` (the world's text and whatever else the stored
+/// result depends on), so changing any of them names another file.
+pub fn run_key(world: &Path, parts: &[&[u8]], seed: u64) -> String {
+    let mut h = Sha256::new();
+    for p in parts {
+        h.update(p);
+    }
+    let digest = h.finalize();
+    let hex: String = digest[..6].iter().map(|b| format!("{b:02x}")).collect();
+    let stem = world
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("world");
+    format!("{stem}-{hex}-s{seed}")
 }
 
 /// Expands `--set path=v1,v2` sweeps into every combination (the cartesian product, in

@@ -237,15 +237,15 @@ impl Bank {
     /// recorded density), and joins the others; models of other sweeps stay. The bank is
     /// kept in order of sweep, fastest first, then of median density.
     pub fn insert(&mut self, model: Model) {
+        let Some(d) = model.events_per_point else {
+            return self.replace_sweep(model);
+        };
         let sweep = model.sweep();
-        match model.events_per_point {
-            None => self.0.retain(|m| m.sweep() != sweep),
-            Some(d) => self.0.retain(|m| {
-                m.sweep() != sweep
-                    || m.events_per_point
-                        .is_some_and(|e| e.median < d.min || e.median > d.max)
-            }),
-        }
+        self.0.retain(|m| {
+            m.sweep() != sweep
+                || m.events_per_point
+                    .is_some_and(|e| e.median < d.min || e.median > d.max)
+        });
         self.0.push(model);
         self.sort();
     }
