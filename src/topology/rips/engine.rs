@@ -20,7 +20,10 @@
 //!    filtration order, with the implicit coboundary (cofacets enumerated from the points,
 //!    never stored), the emergent-pair shortcut (a column whose oldest cofacet is nobody's
 //!    pivot is already reduced), and a radix heap as the working column (`column.rs`); reduced columns
-//!    are kept as their few reduction-matrix entries and their coboundaries regenerated.
+//!    are kept as their few reduction-matrix entries and their coboundaries regenerated
+//!    (only from the pivot up: below it they cancel). Which vertices a coboundary scan
+//!    tests is the metric's choice ([`Metric::cofacets`]): a 2-D or 3-D point cloud scans
+//!    only the grid cells within reach of the edge.
 //!    The working column holds only cofacets up to a bound that is raised as it empties;
 //!    a raise doubles the bound unless a sample of the column predicts more than
 //!    [`PUSH_BUDGET`] new entries, then it steps less (`Reducer::raise`). The cocycle of a
@@ -303,35 +306,14 @@ impl<M: Metric> Reducer<'_, M> {
         self.pivots.get(tau).map(|&j| Owner::Reduced(j))
     }
 
-    /// Pushes the cofacets of `e` with value in `(lo, hi]` (`hi` ≤ the threshold), in the
-    /// order of their apex. The vertices are tested in blocks whose test the compiler can
-    /// vectorise, and only a block with a hit is scanned again to push: the raises of a
-    /// long column push few of each edge's ~n cofacets (README "Accuracy", step 34: ≥ 1.66×
-    /// on `benches/data/t_lshape_w4_9600.csv`).
+    /// Pushes the cofacets of `e` with value in `(lo, hi]` (`hi` ≤ the threshold). Which
+    /// vertices are tested is the metric's choice ([`Metric::cofacets`]): a point cloud
+    /// scans only the grid cells near `e`.
     fn push_coboundary(&self, heap: &mut Column, e: &Edge, lo: f64, hi: f64) {
-        const W: usize = 16;
         let (a, b) = (e.a as usize, e.b as usize);
-        let d = e.value();
-        let n = self.m.len();
-        let value = |k: usize| d.max(self.m.value(a, k)).max(self.m.value(b, k));
-        let mut start = 0;
-        while start < n {
-            let end = (start + W).min(n);
-            let mut any = false;
-            for k in start..end {
-                let x = value(k);
-                any |= (x <= hi) & (x > lo);
-            }
-            if any {
-                for k in start..end {
-                    let x = value(k);
-                    if x <= hi && x > lo && k != a && k != b {
-                        heap.push(Tri::new(x, a, b, k));
-                    }
-                }
-            }
-            start = end;
-        }
+        self.m.cofacets(a, b, e.value(), lo, hi, |k, x| {
+            heap.push(Tri::new(x, a, b, k))
+        });
     }
 
     /// The next bound above `lo` for the reduction-matrix column `v`: twice `lo` (at most
@@ -356,15 +338,10 @@ impl<M: Metric> Reducer<'_, M> {
             .fold(
                 || [0usize; B],
                 |mut h, e| {
-                    let (a, b) = (e.a as usize, e.b as usize);
-                    let d = e.value();
-                    for k in 0..n {
-                        let x = d.max(self.m.value(a, k)).max(self.m.value(b, k));
-                        if x <= hi && x > lo && k != a && k != b {
-                            let i = (((x - lo) / width) as usize).min(B - 1);
-                            h[i] += 1;
-                        }
-                    }
+                    self.m
+                        .cofacets(e.a as usize, e.b as usize, e.value(), lo, hi, |_, x| {
+                            h[(((x - lo) / width) as usize).min(B - 1)] += 1;
+                        });
                     h
                 },
             )
@@ -441,9 +418,13 @@ impl<M: Metric> Reducer<'_, M> {
                     v.push(f);
                 }
                 Some(Owner::Reduced(j)) => {
+                    // Column `j`'s coboundary sum has pivot `p`, so its cofacets of lower
+                    // value cancel in pairs: they are not pushed (they would only be
+                    // popped off the column's `below` heap again).
+                    let lo = p.value().next_down();
                     let col = std::mem::take(&mut self.columns[j]);
                     for f in &col {
-                        self.push_coboundary(heap, f, f64::NEG_INFINITY, bound);
+                        self.push_coboundary(heap, f, lo, bound);
                     }
                     v.extend_from_slice(&col);
                     self.columns[j] = col;
@@ -593,7 +574,7 @@ fn compute_with<M: Metric>(m: &M, t: f64, h1: bool, budget: usize) -> Raw {
 mod tests {
     use super::*;
     use crate::topology::PointCloud;
-    use crate::topology::rips::metric::Points;
+    use crate::topology::rips::metric::{Full, Points};
 
     /// Points round two holes of different sizes with a deterministic jitter: long H1
     /// bars whose cocycles grow to thousands of edges.
@@ -643,5 +624,23 @@ mod tests {
             .filter(|p| p.death.is_some_and(|d| d.value() > 4.0 * p.birth.value()))
             .count();
         assert!(long >= 2, "{long} long bars");
+    }
+
+    /// The point metric's grid scan ([`Metric::cofacets`]) and the matrix's full scan give
+    /// the same pairs, death triangles included, on long bars and on a lattice full of ties.
+    #[test]
+    fn grid_and_full_scans_give_the_same_pairs() {
+        let lattice: Vec<[f64; 2]> = (0..400)
+            .map(|i| [(i % 20) as f64, (i / 20) as f64])
+            .collect();
+        for pc in [two_holes(700), PointCloud::from_rows(&lattice).unwrap()] {
+            let p = Points::<2>::new(&pc).unwrap();
+            let f = Full::squared_from_points(&pc);
+            let t = enclosing(&p);
+            assert_eq!(t, enclosing(&f));
+            let (a, b) = (compute(&p, t, true), compute(&f, t, true));
+            assert_eq!(key(&a), key(&b));
+            assert!(!a.pairs.is_empty());
+        }
     }
 }
