@@ -160,8 +160,8 @@ pub(crate) struct Points<const D: usize> {
     grid: Option<Grid<D>>,
 }
 
-/// The squared distance as [`Points::value`] computes it (same operations, same order, so
-/// bit-identical whichever copy of the coordinates it reads).
+/// The squared distance of [`Points::value`], also used on the grid's copy of the
+/// coordinates (same operations in the same order, so bit-identical values).
 #[inline(always)]
 fn sq<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
     let mut s = 0.0;
@@ -280,13 +280,7 @@ impl<const D: usize> Metric for Points<D> {
     }
     #[inline(always)]
     fn value(&self, i: usize, j: usize) -> f64 {
-        let (a, b) = (&self.p[i], &self.p[j]);
-        let mut s = 0.0;
-        for k in 0..D {
-            let d = a[k] - b[k];
-            s += d * d;
-        }
-        s
+        sq(&self.p[i], &self.p[j])
     }
     fn to_distance(&self, v: f64) -> f64 {
         v.sqrt()
