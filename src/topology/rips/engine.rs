@@ -633,7 +633,17 @@ mod tests {
         let lattice: Vec<[f64; 2]> = (0..400)
             .map(|i| [(i % 20) as f64, (i / 20) as f64])
             .collect();
-        for pc in [two_holes(700), PointCloud::from_rows(&lattice).unwrap()] {
+        // Scaled so far down that every squared distance is subnormal, where rounding is
+        // absolute (a review found the grid missing cofacets there).
+        let tiny = two_holes(400);
+        let tiny: Vec<[f64; 2]> = (0..tiny.len())
+            .map(|i| [tiny.point(i)[0] * 1e-161, tiny.point(i)[1] * 1e-161])
+            .collect();
+        for pc in [
+            two_holes(700),
+            PointCloud::from_rows(&lattice).unwrap(),
+            PointCloud::from_rows(&tiny).unwrap(),
+        ] {
             let p = Points::<2>::new(&pc).unwrap();
             let f = Full::squared_from_points(&pc);
             let t = enclosing(&p);

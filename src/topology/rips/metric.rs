@@ -309,8 +309,13 @@ impl<const D: usize> Metric for Points<D> {
             return default_cofacets(self, a, b, d, lo, hi, f);
         };
         // √hi, widened so that rounding cannot exclude a point whose computed value is ≤ hi.
-        let r = hi.sqrt() * (1.0 + 1e-9) + f64::MIN_POSITIVE;
-        if !r.is_finite() {
+        // The margin is relative, which holds while squares are normal numbers: below
+        // `TINY` a subnormal square's absolute rounding can admit a point farther than √hi
+        // by more than any relative margin, so such bounds (all-but-coincident clouds)
+        // scan every vertex.
+        const TINY: f64 = 1e-290;
+        let r = hi.sqrt() * (1.0 + 1e-9);
+        if !r.is_finite() || hi < TINY {
             return default_cofacets(self, a, b, d, lo, hi, f);
         }
         let (pa, pb) = (&self.p[a], &self.p[b]);
@@ -478,6 +483,28 @@ mod tests {
             let c = PointCloud::from_rows(&rows).unwrap();
             let p = Points::<2>::new(&c).unwrap();
             for (a, b, hi) in [(0, 1, 4.0), (10, 20, 150.0), (299, 0, 1e6), (5, 6, 0.0)] {
+                assert_eq!(
+                    listed(&p, a, b, f64::NEG_INFINITY, hi, true),
+                    listed(&p, a, b, f64::NEG_INFINITY, hi, false)
+                );
+            }
+        }
+        // Every squared distance subnormal: rounding is absolute there, and bounds equal to
+        // the values of actual cofacets are where a box too tight would drop them.
+        let mut r = stream(7);
+        let tiny: Vec<[f64; 2]> = (0..300).map(|_| [1e-158 * r(), 1e-158 * r()]).collect();
+        let c = PointCloud::from_rows(&tiny).unwrap();
+        let p = Points::<2>::new(&c).unwrap();
+        for _ in 0..200 {
+            let (a, b, k) = (
+                (r() * 300.0) as usize,
+                (r() * 300.0) as usize,
+                (r() * 300.0) as usize,
+            );
+            if a == b {
+                continue;
+            }
+            for hi in [0.0, p.value(a, k), p.value(b, k), 2.0 * p.value(a, k)] {
                 assert_eq!(
                     listed(&p, a, b, f64::NEG_INFINITY, hi, true),
                     listed(&p, a, b, f64::NEG_INFINITY, hi, false)
