@@ -489,27 +489,30 @@ mod tests {
                 );
             }
         }
-        // Every squared distance subnormal: rounding is absolute there, and bounds equal to
-        // the values of actual cofacets are where a box too tight would drop them.
+        // Squared distances in the subnormal range round absolutely, so a point can be
+        // farther than the computed √bound by more than any relative margin. Put `q` on the
+        // first abscissa of grid column 3 and `a` (and its duplicate `b`) just left of it,
+        // at a distance whose square rounds down: the bound is exactly the cofacet's value.
         let mut r = stream(7);
-        let tiny: Vec<[f64; 2]> = (0..300).map(|_| [1e-158 * r(), 1e-158 * r()]).collect();
+        let mut tiny: Vec<[f64; 2]> = vec![[0.0, 0.0], [1e-158, 1e-158]];
+        tiny.extend((0..297).map(|_| [1e-158 * r(), 1e-158 * r()]));
+        let grid = Grid::new(&tiny).unwrap();
+        let mut x = 3.0 / grid.inv;
+        while grid.col(x) < 3 {
+            x = x.next_up();
+        }
+        while grid.col(x.next_down()) == 3 {
+            x = x.next_down();
+        }
+        let dx = 10.4f64.sqrt() * 2f64.powi(-537);
+        tiny.extend([[x, 5e-159], [x - dx, 5e-159], [x - dx, 5e-159]]);
         let c = PointCloud::from_rows(&tiny).unwrap();
         let p = Points::<2>::new(&c).unwrap();
-        for _ in 0..200 {
-            let (a, b, k) = (
-                (r() * 300.0) as usize,
-                (r() * 300.0) as usize,
-                (r() * 300.0) as usize,
-            );
-            if a == b {
-                continue;
-            }
-            for hi in [0.0, p.value(a, k), p.value(b, k), 2.0 * p.value(a, k)] {
-                assert_eq!(
-                    listed(&p, a, b, f64::NEG_INFINITY, hi, true),
-                    listed(&p, a, b, f64::NEG_INFINITY, hi, false)
-                );
-            }
-        }
+        let (q, a, b) = (299, 300, 301);
+        let hi = p.value(a, q);
+        assert!(hi > 0.0 && hi < f64::MIN_POSITIVE);
+        let full = listed(&p, a, b, f64::NEG_INFINITY, hi, false);
+        assert!(full.contains(&(q, hi.to_bits())));
+        assert_eq!(listed(&p, a, b, f64::NEG_INFINITY, hi, true), full);
     }
 }
