@@ -735,3 +735,19 @@ fn rips_points_defaults_to_1200_and_can_be_set() {
         600
     );
 }
+
+#[test]
+fn agent_timelines_defaults_to_false_and_can_be_set() {
+    assert!(!check_text("()").expect("valid").mapping.agent_timelines);
+    let w = check_text("(mapping: (agent_timelines: true))").expect("valid");
+    assert!(w.mapping.agent_timelines);
+    assert!(
+        valid_with("mapping.agent_timelines", "true")
+            .mapping
+            .agent_timelines
+    );
+    let err = check_text("(mapping: (agent_timelines: 1))")
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with("t.ron:1:28: Expected boolean"), "{err}");
+}

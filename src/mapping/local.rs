@@ -72,6 +72,9 @@ pub struct LocalParams {
     /// lead to ([`super::bridge`]) instead of where landmark MDS puts them (default:
     /// `false`; the `Embedded` method sets it).
     pub bridge: bool,
+    /// Then place them on their agents' time lines, pinned by the encounters with
+    /// landmarks, with this floor τ in seconds ([`super::timelines`]; default: `None`).
+    pub timelines: Option<f64>,
 }
 
 impl Default for LocalParams {
@@ -89,6 +92,7 @@ impl Default for LocalParams {
             witness: None,
             embedding_rips: None,
             bridge: false,
+            timelines: None,
         }
     }
 }
@@ -117,6 +121,9 @@ impl LocalParams {
             p.anchored = true;
             p.embedding_rips = Some(super::dense::DenseParams::embedded_with(m.rips_points));
             p.bridge = true;
+            if m.agent_timelines {
+                p.timelines = Some(super::timelines::TIMELINE_FLOOR);
+            }
         }
         p
     }
@@ -382,6 +389,9 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     &sub.rows,
                     super::bridge::EXIT_CANDIDATES,
                 );
+            }
+            if let Some(floor) = p.timelines {
+                super::timelines::place_on_timelines(&mut points, &enc, &members, &anchored, floor);
             }
         }
         let opts = RipsOptions {

@@ -10,5 +10,6 @@ pub mod pipeline;
 pub mod stitch;
 pub mod subsample;
 pub mod synthetic;
+pub mod timelines;
 pub mod windows;
 pub mod witness;

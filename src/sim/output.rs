@@ -145,6 +145,9 @@ pub fn world_json(world: &World) -> Value {
     if m.encounter_midpoints {
         v["mapping"]["encounter_midpoints"] = json!(true);
     }
+    if m.agent_timelines {
+        v["mapping"]["agent_timelines"] = json!(true);
+    }
     if m.rips_points != crate::mapping::dense::EMBEDDED_POINTS {
         v["mapping"]["rips_points"] = json!(m.rips_points);
     }

@@ -634,6 +634,7 @@ impl WorldSpec {
             after_landmarks: m.after_landmarks.unwrap_or(md.after_landmarks),
             encounter_midpoints: m.encounter_midpoints.unwrap_or(md.encounter_midpoints),
             rips_points,
+            agent_timelines: m.agent_timelines.unwrap_or(md.agent_timelines),
         };
 
         let world = World {

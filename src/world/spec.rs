@@ -114,6 +114,7 @@ pub struct MappingSpec {
     pub after_landmarks: Option<bool>,
     pub encounter_midpoints: Option<bool>,
     pub rips_points: Option<i64>,
+    pub agent_timelines: Option<bool>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -275,6 +276,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.after_landmarks",
     "mapping.encounter_midpoints",
     "mapping.rips_points",
+    "mapping.agent_timelines",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -397,6 +399,7 @@ impl WorldSpec {
                             "after_landmarks" => put(&mut s.after_landmarks, p, v)?,
                             "encounter_midpoints" => put(&mut s.encounter_midpoints, p, v)?,
                             "rips_points" => put(&mut s.rips_points, p, v)?,
+                            "agent_timelines" => put(&mut s.agent_timelines, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

@@ -166,7 +166,15 @@ impl World {
                 "the paper's interval-gap weights"
             },
             if m.method == super::MappingMethod::Embedded {
-                format!("; {} planar Rips points", m.rips_points)
+                format!(
+                    "; {} planar Rips points{}",
+                    m.rips_points,
+                    if m.agent_timelines {
+                        "; encounters placed on their agents' time lines"
+                    } else {
+                        ""
+                    }
+                )
             } else {
                 String::new()
             }

@@ -178,6 +178,10 @@ pub struct MappingParams {
     /// truth-position oracle, MaxMin-picked from a window's events and shared among its
     /// components (`mapping::dense`; default: `1200`).
     pub rips_points: usize,
+    /// The `Embedded` method places the encounters of moving agents on their agents' time
+    /// lines, pinned by the encounters with landmarks (`mapping::timelines`), after the
+    /// bridge between exit landmarks (default: `false`).
+    pub agent_timelines: bool,
 }
 
 impl Default for MappingParams {
@@ -193,6 +197,7 @@ impl Default for MappingParams {
             after_landmarks: false,
             encounter_midpoints: false,
             rips_points: crate::mapping::dense::EMBEDDED_POINTS,
+            agent_timelines: false,
         }
     }
 }
