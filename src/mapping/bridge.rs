@@ -147,43 +147,15 @@ mod tests {
     /// true positions, seed after seed.
     #[test]
     fn bridging_lowers_the_embedding_error_on_synthetic_logs() {
-        use crate::mapping::local::{LocalParams, local_map};
-        use crate::mapping::synthetic::{SyntheticParams, synthetic_log};
-        use crate::mapping::windows::Window;
+        use crate::mapping::local::LocalParams;
+        use crate::mapping::synthetic::square_embedding_error;
         let mut p = LocalParams::from_mapping(&crate::world::MappingParams {
             method: crate::world::MappingMethod::Embedded,
             ..Default::default()
         });
         assert!(p.bridge);
         for seed in 1..=3 {
-            let log = synthetic_log(
-                &SyntheticParams {
-                    landmarks: 30,
-                    width: 6.0,
-                    height: 6.0,
-                    detection_radius: 0.1,
-                    seed,
-                    ..Default::default()
-                },
-                4000,
-            );
-            let end = log.encounters.iter().map(|e| e.end).fold(0.0, f64::max);
-            let w = Window {
-                index: 1,
-                start: 0.0,
-                end,
-            };
-            let error = |p: &LocalParams| {
-                let map = local_map(&log, &w, p);
-                crate::mapping::pipeline::fidelity(
-                    &map,
-                    &log,
-                    72f64.sqrt(),
-                    crate::mapping::dense::EMBEDDED_POINTS,
-                )
-                .procrustes
-                .expect("truth columns")
-            };
+            let error = |p: &LocalParams| square_embedding_error(p, seed);
             p.bridge = true;
             let bridged = error(&p);
             p.bridge = false;

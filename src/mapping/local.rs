@@ -390,7 +390,11 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     super::bridge::EXIT_CANDIDATES,
                 );
             }
-            if let Some(floor) = p.timelines {
+            // Pinned by fewer than 3 landmark encounters, a component's time lines would
+            // collapse onto them: it keeps the embedding's places, as it keeps its
+            // representatives above.
+            let landmark_count = members.iter().filter(|&&j| anchored[j]).count();
+            if let Some(floor) = p.timelines.filter(|_| landmark_count >= 3) {
                 super::timelines::place_on_timelines(&mut points, &enc, &members, &anchored, floor);
             }
         }

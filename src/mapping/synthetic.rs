@@ -168,6 +168,35 @@ pub fn synthetic_log(p: &SyntheticParams, encounters: usize) -> EncounterLog {
     }
 }
 
+/// The Procrustes error of the `Embedded` cloud of one synthetic log (a 6 m square, 30
+/// static landmarks among 100 agents, r_d = 10 cm, 4 000 steps of seed `seed`) mapped as one
+/// window with `p`: the yardstick of the tests that compare placements of the moving
+/// agents' encounters ([`super::bridge`], [`super::timelines`]).
+#[cfg(test)]
+pub(crate) fn square_embedding_error(p: &super::local::LocalParams, seed: u64) -> f64 {
+    let log = synthetic_log(
+        &SyntheticParams {
+            landmarks: 30,
+            width: 6.0,
+            height: 6.0,
+            detection_radius: 0.1,
+            seed,
+            ..Default::default()
+        },
+        4000,
+    );
+    let end = log.encounters.iter().map(|e| e.end).fold(0.0, f64::max);
+    let w = super::windows::Window {
+        index: 1,
+        start: 0.0,
+        end,
+    };
+    let map = super::local::local_map(&log, &w, p);
+    super::pipeline::fidelity(&map, &log, 72f64.sqrt(), super::dense::EMBEDDED_POINTS)
+        .procrustes
+        .expect("truth columns")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

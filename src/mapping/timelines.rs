@@ -51,13 +51,16 @@ use std::collections::BTreeMap;
 /// and 10 s give the missed obstacle 3.77, 3.98, 3.64 and 3.13 σ (README step 36).
 pub const TIMELINE_FLOOR: f64 = 1.0;
 
-/// Relative residual at which conjugate gradients stop.
+/// Residual, relative to the system's scale, at which conjugate gradients stop.
 const TOLERANCE: f64 = 1e-10;
 
 /// Re-places every encounter of `members` (indices into `enc`) that is not `fixed` at the
 /// most likely position given the fixed ones and its agents' time lines (module docs).
 /// `points[j]` holds encounter `j`'s current position (the start of the solve; kept when
-/// nothing pins it). Returns the number of encounters placed.
+/// nothing pins it). `floor` is τ in seconds and must be positive (at τ = 0 two encounters
+/// of one agent at the same time would have to coincide; such a pair is left unlinked).
+/// Encounters with a non-finite time or position take no part: they link nothing and keep
+/// their position. Returns the number of encounters placed.
 pub fn place_on_timelines(
     points: &mut [[f64; 3]],
     enc: &[Encounter],
@@ -67,7 +70,12 @@ pub fn place_on_timelines(
 ) -> usize {
     // Each agent's encounters among the members, in time order of their middles.
     let mut lines: BTreeMap<u32, Vec<(f64, usize)>> = BTreeMap::new();
-    for &j in members {
+    debug_assert!(floor > 0.0, "τ must be positive, got {floor}");
+    let usable = |j: usize| {
+        let e = &enc[j];
+        (e.start + e.end).is_finite() && points[j].iter().all(|x| x.is_finite())
+    };
+    for &j in members.iter().filter(|&&j| usable(j)) {
         let e = &enc[j];
         let mid = 0.5 * (e.start + e.end);
         for agent in [e.a, e.b] {
@@ -77,7 +85,7 @@ pub fn place_on_timelines(
     // Free encounters get consecutive indices; fixed ones are boundary values.
     let mut free_index = vec![usize::MAX; enc.len()];
     let mut free = Vec::new();
-    for &j in members {
+    for &j in members.iter().filter(|&&j| usable(j)) {
         if !fixed[j] && free_index[j] == usize::MAX {
             free_index[j] = free.len();
             free.push(j);
@@ -194,14 +202,19 @@ fn conjugate_gradients(
     let mut ax = vec![0.0; n];
     apply(x, &mut ax);
     let mut r: Vec<f64> = b.iter().zip(&ax).map(|(b, a)| b - a).collect();
-    let norm_b = dot(b, b).sqrt().max(f64::MIN_POSITIVE);
+    // The scale of the system: ‖b‖, or ‖A x₀‖ where the boundary values are all near 0 (a
+    // coordinate the walks barely use), so that the stop does not chase a vanishing ‖b‖.
+    let scale = dot(b, b).sqrt().max(dot(&ax, &ax).sqrt());
+    if scale == 0.0 || !scale.is_finite() {
+        return;
+    }
     let mut z = vec![0.0; n];
     precondition(&r, &mut z);
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
     let mut ap = vec![0.0; n];
     for _ in 0..max_iter {
-        if dot(&r, &r).sqrt() <= TOLERANCE * norm_b || rz <= 0.0 {
+        if dot(&r, &r).sqrt() <= TOLERANCE * scale || rz <= 0.0 {
             break;
         }
         apply(&p, &mut ap);
@@ -256,7 +269,7 @@ mod tests {
             [10.0, 0.0, 0.0],
         ];
         let fixed = [true, false, false, true];
-        for tau in [0.0, 1.0, 2.5] {
+        for tau in [0.25, 1.0, 2.5] {
             let placed = place_on_timelines(&mut points, &enc, &[0, 1, 2, 3], &fixed, tau);
             assert_eq!(placed, 2);
             let total = 10.0 + 3.0 * tau;
@@ -314,8 +327,13 @@ mod tests {
         for k in 0..120 {
             let a = rng.random_range(0..agents);
             let b = (a + rng.random_range(1..agents)) % agents;
-            enc.push(encounter(k as f64 * 0.7 + rng.random::<f64>(), a, b));
+            let start = k as f64 * 0.7 + rng.random::<f64>();
+            enc.push(Encounter {
+                end: start + 3.0 * rng.random::<f64>(),
+                ..encounter(start, a, b)
+            });
         }
+        let mid = |j: usize| 0.5 * (enc[j].start + enc[j].end);
         let fixed: Vec<bool> = (0..enc.len()).map(|k| k % 7 == 0).collect();
         let start: Vec<[f64; 3]> = (0..enc.len())
             .map(|_| {
@@ -335,7 +353,7 @@ mod tests {
         for agent in 0..agents {
             let mut line: Vec<(f64, usize)> = (0..n)
                 .filter(|&j| enc[j].a == agent || enc[j].b == agent)
-                .map(|j| (enc[j].start, j))
+                .map(|j| (mid(j), j))
                 .collect();
             line.sort_by(|x, y| x.0.total_cmp(&y.0));
             for p in line.windows(2) {
@@ -381,9 +399,8 @@ mod tests {
     /// error against the true positions below the bridge's, seed after seed.
     #[test]
     fn time_lines_lower_the_embedding_error_on_synthetic_logs() {
-        use crate::mapping::local::{LocalParams, local_map};
-        use crate::mapping::synthetic::{SyntheticParams, synthetic_log};
-        use crate::mapping::windows::Window;
+        use crate::mapping::local::LocalParams;
+        use crate::mapping::synthetic::square_embedding_error;
         let mut p = LocalParams::from_mapping(&crate::world::MappingParams {
             method: crate::world::MappingMethod::Embedded,
             agent_timelines: true,
@@ -391,34 +408,7 @@ mod tests {
         });
         assert_eq!(p.timelines, Some(TIMELINE_FLOOR));
         for seed in 1..=3 {
-            let log = synthetic_log(
-                &SyntheticParams {
-                    landmarks: 30,
-                    width: 6.0,
-                    height: 6.0,
-                    detection_radius: 0.1,
-                    seed,
-                    ..Default::default()
-                },
-                4000,
-            );
-            let end = log.encounters.iter().map(|e| e.end).fold(0.0, f64::max);
-            let w = Window {
-                index: 1,
-                start: 0.0,
-                end,
-            };
-            let error = |p: &LocalParams| {
-                let map = local_map(&log, &w, p);
-                crate::mapping::pipeline::fidelity(
-                    &map,
-                    &log,
-                    72f64.sqrt(),
-                    crate::mapping::dense::EMBEDDED_POINTS,
-                )
-                .procrustes
-                .expect("truth columns")
-            };
+            let error = |p: &LocalParams| square_embedding_error(p, seed);
             p.timelines = Some(TIMELINE_FLOOR);
             let on_lines = error(&p);
             p.timelines = None;
@@ -428,6 +418,36 @@ mod tests {
             );
             assert!(on_lines < bridged, "seed {seed}: {on_lines} vs {bridged}");
         }
+    }
+
+    /// A walk whose landmark position is not finite takes no part; another walk is solved
+    /// as if it were alone.
+    #[test]
+    fn a_non_finite_position_stays_in_its_own_walk() {
+        let enc = vec![
+            encounter(0.0, 0, 10),
+            encounter(5.0, 0, 1),
+            encounter(10.0, 0, 11),
+            encounter(0.0, 2, 12),
+            encounter(5.0, 2, 3),
+            encounter(10.0, 2, 13),
+        ];
+        let mut points = vec![
+            [0.0; 3],
+            [3.0, 3.0, 3.0],
+            [10.0, 0.0, 0.0],
+            [f64::NAN, 0.0, 0.0],
+            [3.0, 3.0, 3.0],
+            [10.0, 0.0, 0.0],
+        ];
+        let fixed = [true, false, true, true, false, true];
+        let placed = place_on_timelines(&mut points, &enc, &[0, 1, 2, 3, 4, 5], &fixed, 1.0);
+        assert_eq!(placed, 2, "the second walk is still pinned by (10, 0, 0)");
+        assert!((points[1][0] - 5.0).abs() < 1e-9, "{:?}", points[1]);
+        assert!(points[1][1].abs() < 1e-9 && points[1][2].abs() < 1e-9);
+        // Pinned by its end alone, the second walk's encounter goes there.
+        assert!((points[4][0] - 10.0).abs() < 1e-9, "{:?}", points[4]);
+        assert!(points[3][0].is_nan());
     }
 
     #[test]
