@@ -186,7 +186,8 @@ pub fn place_on_timelines(
 
 /// Jacobi-preconditioned conjugate gradients for `A x = b`, `A` symmetric positive
 /// definite on the rows where `diag > 0` (the others are zero in `A` and `b`), from the
-/// start `x`; stops at a relative residual of [`TOLERANCE`] or after `max_iter` steps.
+/// start `x`; stops at a residual of [`TOLERANCE`] times max(‖b‖, ‖A x₀‖) or after
+/// `max_iter` steps.
 fn conjugate_gradients(
     apply: &dyn Fn(&[f64], &mut [f64]),
     diag: &[f64],
