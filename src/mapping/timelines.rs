@@ -153,15 +153,11 @@ pub fn place_on_timelines(
             pinned[r]
         })
         .collect();
+    // A free neighbour lies in the same part, so it is solved exactly when `i` is.
     let apply = |x: &[f64], y: &mut [f64]| {
         for i in 0..n {
             y[i] = if solved[i] {
-                diag[i] * x[i]
-                    - adj[i]
-                        .iter()
-                        .filter(|(k, _)| solved[*k])
-                        .map(|&(k, w)| w * x[k])
-                        .sum::<f64>()
+                diag[i] * x[i] - adj[i].iter().map(|&(k, w)| w * x[k]).sum::<f64>()
             } else {
                 0.0
             };
