@@ -183,20 +183,23 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("method,h1_ratio,h1_span,windows,b1_right,holeless,false_holes,within_cap")
+        Some(
+            "method,h1_ratio,h1_span,h1_crossing,windows,b1_right,holeless,false_holes,within_cap"
+        )
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    // Death / birth 1 to 8 in steps of 0.1, a life of 0 to 20 σ in steps of 0.25 σ.
+    // Death / birth 1 to 8 in steps of 0.1, a life of 0 to 20 σ in steps of 0.25 σ; no
+    // crossing test without `--crossing`.
     assert_eq!(rows.len(), 71 * 81);
     assert!(
         rows.iter()
-            .all(|r| r.len() == 8 && r[0] == "Paper" && r[3] == "4")
+            .all(|r| r.len() == 9 && r[0] == "Paper" && r[3].is_empty() && r[4] == "4")
     );
     // Unconstrained, every point is within the cap, and the fitted rule scores the most.
-    assert!(rows.iter().all(|r| r[7] == "true"));
+    assert!(rows.iter().all(|r| r[8] == "true"));
     let best = rows
         .iter()
-        .map(|r| r[4].parse::<usize>().unwrap())
+        .map(|r| r[5].parse::<usize>().unwrap())
         .max()
         .unwrap();
     let c = models(&out).paper.first().classifier;
@@ -206,7 +209,50 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
             r[1].parse::<f64>().unwrap() == c.h1_ratio && r[2].parse::<f64>().unwrap() == c.h1_span
         })
         .expect("the fitted rule is a grid point");
-    assert_eq!(fitted[4].parse::<usize>().unwrap(), best);
+    assert_eq!(fitted[5].parse::<usize>().unwrap(), best);
+}
+
+/// With `--crossing` the `Embedded` method's grid also runs over the largest crossing share
+/// (24 values, each with the lives from 1 σ), the fit says so, and the model it writes
+/// carries `h1_crossing` exactly when its rule has one.
+#[test]
+fn crossing_adds_the_share_to_the_embedded_grid() {
+    let (dir, out) = shipped_copy();
+    let land = dir.path().join("landscape.csv");
+    let stdout = calibrate(
+        &out,
+        &[
+            "--crossing",
+            "--set",
+            "mapping.method=Embedded",
+            "--landscape",
+            land.to_str().unwrap(),
+        ],
+    );
+    assert!(stdout.contains("h1_crossing"), "{stdout}");
+    let text = std::fs::read_to_string(&land).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 71 * 81 + 24 * 71 * 77);
+    let shares: std::collections::BTreeSet<&str> = rows.iter().map(|r| r[3]).collect();
+    assert_eq!(shares.len(), 25, "{shares:?}");
+    assert!(shares.contains("") && shares.contains("0.01") && shares.contains("0.2"));
+    let m = models(&out);
+    let fit = &m.embedded.for_sweep(TINY_SWEEP).0[0];
+    assert!(fit.fitted_on.contains(" --crossing "), "{}", fit.fitted_on);
+    let c = fit.classifier;
+    let row = rows
+        .iter()
+        .find(|r| {
+            r[1].parse::<f64>().unwrap() == c.h1_ratio
+                && r[2].parse::<f64>().unwrap() == c.h1_span
+                && r[3] == c.h1_crossing.map_or(String::new(), |x| x.to_string())
+        })
+        .expect("the fitted rule is a grid point");
+    assert_eq!(row[0], "Embedded");
 }
 
 /// One calibration fits the method's and the oracle's models from the same runs, and each

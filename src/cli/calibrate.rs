@@ -6,7 +6,9 @@ use anyhow::{Context, anyhow};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use std::path::PathBuf;
-use swarmmap::eval::calibrate::{CrossValidation, Sample, cross_validate, fit, h1_landscape};
+use swarmmap::eval::calibrate::{
+    CrossValidation, FitOptions, Sample, cross_validate, fit, h1_landscape,
+};
 use swarmmap::eval::campaign::run_key;
 use swarmmap::eval::truth::{FreeSpace, window_band};
 use swarmmap::io::write_atomic;
@@ -53,6 +55,11 @@ pub struct CalibrateArgs {
     /// may report one; accuracy is maximised under this constraint (`1` = unconstrained).
     #[arg(long, default_value_t = swarmmap::eval::calibrate::MAX_FALSE_HOLES)]
     pub max_false_holes: f64,
+    /// Also search a largest crossing share for H1 (`h1_crossing`: the share of the moving
+    /// agents' time lines near a loop's void that pass through it, "Mapping"), for the
+    /// `Embedded` method; a crossing test is kept only where it scores more than none.
+    #[arg(long)]
+    pub crossing: bool,
     /// Also estimate the fit's accuracy on windows it was not fitted on: hold out each seed
     /// (or each world) in turn, fit on the rest under the same cap, judge the held-out
     /// windows. Repeat the option for both. The model written is still the fit on all.
@@ -92,9 +99,12 @@ struct StoredFit {
 #[derive(serde::Serialize, serde::Deserialize)]
 struct StoredWindow {
     truth: [usize; 2],
-    /// Per component: `(dim, birth, death)`.
-    components: Vec<Vec<(usize, u64, Option<u64>)>>,
+    /// Per component: its bars.
+    components: Vec<Vec<StoredBar>>,
 }
+
+/// A bar as `--runs` keeps it: `(dim, birth, death, crossing share)`, numbers as bits.
+type StoredBar = (usize, u64, Option<u64>, Option<u64>);
 
 impl StoredWindow {
     fn from_sample(s: &Sample) -> Self {
@@ -107,7 +117,12 @@ impl StoredWindow {
                     c.iter()
                         .map(|f| {
                             let death = f.death.is_finite().then_some(f.death.to_bits());
-                            (f.dim, f.birth.to_bits(), death)
+                            (
+                                f.dim,
+                                f.birth.to_bits(),
+                                death,
+                                f.crossing.map(f64::to_bits),
+                            )
                         })
                         .collect()
                 })
@@ -123,10 +138,11 @@ impl StoredWindow {
                 .iter()
                 .map(|c| {
                     c.iter()
-                        .map(|&(dim, birth, death)| Feature {
+                        .map(|&(dim, birth, death, crossing)| Feature {
                             dim,
                             birth: f64::from_bits(birth),
                             death: death.map_or(f64::INFINITY, f64::from_bits),
+                            crossing: crossing.map(f64::from_bits),
                         })
                         .collect()
                 })
@@ -378,8 +394,9 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     }
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     // One file for every method fitted (`--landscape`), written once at the end.
-    let mut csv =
-        String::from("method,h1_ratio,h1_span,windows,b1_right,holeless,false_holes,within_cap\n");
+    let mut csv = String::from(
+        "method,h1_ratio,h1_span,h1_crossing,windows,b1_right,holeless,false_holes,within_cap\n",
+    );
     for Training {
         target: method,
         samples,
@@ -387,7 +404,11 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         origin,
     } in &by_method
     {
-        let f = fit(samples, args.max_false_holes).ok_or_else(|| {
+        let options = FitOptions {
+            max_false_holes: args.max_false_holes,
+            crossing: args.crossing && *method != Target::Oracle,
+        };
+        let f = fit(samples, options).ok_or_else(|| {
             input(anyhow!(
                 "no classifier shows false holes in at most {} of the {} training windows \
                  without a hole; allow more with --max-false-holes",
@@ -396,12 +417,13 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             ))
         })?;
         println!(
-            "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}; training windows {}: \
+            "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}; training windows {}: \
              both right {:.1} %, β0 {:.1} %, β1 {:.1} %, false holes {:.1} % of hole-free windows",
             target_name(method),
             f.classifier.h0_ratio,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
+            crossing_text(f.classifier.h1_crossing),
             f.windows,
             100.0 * f.accuracy,
             100.0 * f.b0_accuracy,
@@ -410,12 +432,13 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         );
         if args.landscape.is_some() {
             let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
-            for p in h1_landscape(samples) {
+            for p in h1_landscape(samples, options.crossing) {
                 csv.push_str(&format!(
-                    "{},{},{},{},{},{},{},{}\n",
+                    "{},{},{},{},{},{},{},{},{}\n",
                     target_name(method),
                     p.h1_ratio,
                     p.h1_span,
+                    p.h1_crossing.map_or(String::new(), |x| x.to_string()),
                     samples.len(),
                     p.b1_right,
                     holeless,
@@ -433,8 +456,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     CvGroups::Worlds => world.clone(),
                 })
                 .collect();
-            let cv = cross_validate(samples, &labels, args.max_false_holes)
-                .map_err(|e| input(anyhow!(e)))?;
+            let cv = cross_validate(samples, &labels, options).map_err(|e| input(anyhow!(e)))?;
             print_cross_validation(groups, &cv);
             held_out.push_str(&format!(
                 "; held out by {}: {:.1} % right, false holes in {:.1} %",
@@ -455,12 +477,17 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             );
         }
         let fitted_on = format!(
-            "swarmmap calibrate{}{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
+            "swarmmap calibrate{}{}{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
             match method {
                 Target::Oracle => " --oracle",
                 Target::Method(_) => "",
             },
             if args.only { " --only" } else { "" },
+            if args.crossing && *method != Target::Oracle {
+                " --crossing"
+            } else {
+                ""
+            },
             args.seeds,
             args.max_false_holes,
             args.cross_validate
@@ -536,10 +563,11 @@ fn print_cross_validation(groups: CvGroups, cv: &CrossValidation) {
     );
     for f in &cv.folds {
         println!(
-            "    without {:<12} h1_ratio {:.2}, h1_span {:.2}, h0_ratio {:.2}: {}/{} right, false holes {}/{}",
+            "    without {:<12} h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}, h0_ratio {:.2}: {}/{} right, false holes {}/{}",
             f.held_out,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
+            crossing_text(f.classifier.h1_crossing),
             f.classifier.h0_ratio,
             f.right,
             f.windows,
@@ -573,4 +601,9 @@ fn target_name(target: &Target) -> String {
         Target::Method(m) => format!("{m:?}"),
         Target::Oracle => "Oracle".to_string(),
     }
+}
+
+/// A model's largest crossing share as printed: the value, or `none` (no crossing test).
+fn crossing_text(c: Option<f64>) -> String {
+    c.map_or_else(|| "none".to_string(), |x| format!("{x:.3}"))
 }

@@ -16,6 +16,15 @@
 //! tied points lies on the first (README, "Accuracy", step 23; `swarmmap calibrate
 //! --landscape` writes the grid).
 //!
+//! With `--crossing` ([`FitOptions::crossing`]) the H1 grid also runs over a largest crossing
+//! share ([`crate::mapping::crossing`]): no test, then 24 values (`h1_crossings`), each
+//! with the lives from [`crate::mapping::crossing::CROSSING_FLOOR`] σ. A crossing test is
+//! kept only when it scores more than every rule without one, so on a tie the fit is the
+//! plain one; otherwise the middle of the shares that reach the top is taken, then the
+//! middle in (ratio, span) within it. The grid is scored column by column (one crossing
+//! test and ratio, all spans at once, `Prepared::column`): a bar that passes at some span
+//! passes at every smaller one.
+//!
 //! The two failure modes do not cost the same: a map that invents a hole in an empty room
 //! misleads, and the acceptance target asks that an empty arena show no hole in ≥ 95 % of
 //! windows. So the H1 search is constrained: among the training windows whose truth has no
@@ -48,9 +57,8 @@ impl Sample {
                     c.diagram
                         .iter()
                         .map(|b| Feature {
-                            dim: b.dim,
-                            birth: b.birth,
-                            death: b.death.unwrap_or(f64::INFINITY),
+                            crossing: b.crossing,
+                            ..Feature::bar(b.dim, b.birth, b.death.unwrap_or(f64::INFINITY))
                         })
                         .collect()
                 })
@@ -81,8 +89,30 @@ pub struct Fit {
     pub false_holes: f64,
 }
 
-/// Default of [`fit`]'s `max_false_holes`.
+/// Default of [`FitOptions::max_false_holes`].
 pub const MAX_FALSE_HOLES: f64 = 0.02;
+
+/// What [`fit`] searches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitOptions {
+    /// The largest share of the hole-free training windows that may show a hole (module
+    /// docs; default [`MAX_FALSE_HOLES`]).
+    pub max_false_holes: f64,
+    /// Also search a largest crossing share (`h1_crossings`; `calibrate --crossing`).
+    /// Off by default: on the training worlds it gains 4 of 450 windows and carries worse
+    /// to unseen ones (README "Accuracy", step 37).
+    pub crossing: bool,
+}
+
+impl FitOptions {
+    /// The persistence-only search under a false-hole cap.
+    pub fn cap(max_false_holes: f64) -> Self {
+        Self {
+            max_false_holes,
+            crossing: false,
+        }
+    }
+}
 
 /// The grid of each threshold, its points rounded to 10⁻⁹ so that the model file reads
 /// `3.8`, not `3.8000000000000003`.
@@ -103,18 +133,53 @@ fn h1_spans() -> Vec<f64> {
     grid(0.0, 20.0, 0.25)
 }
 
+/// The H1 grid of [`fit`]: no crossing test, then a largest crossing share
+/// ([`crate::mapping::crossing`]) of 0.01 to 0.1 in steps of 0.005 and 0.12 to 0.2 in steps
+/// of 0.02. With a share, the life grid starts at [`crate::mapping::crossing::CROSSING_FLOOR`]
+/// σ: a bar below it has no share, so it would pass any share.
+fn h1_crossings() -> Vec<Option<f64>> {
+    std::iter::once(None)
+        .chain(grid(0.01, 0.1, 0.005).into_iter().map(Some))
+        .chain(grid(0.12, 0.2, 0.02).into_iter().map(Some))
+        .collect()
+}
+
+/// The columns of [`fit`]'s H1 grid, in grid order (crossing, then ratio); each column
+/// runs over its spans ([`Prepared::column`]).
+fn h1_columns(crossing: bool) -> Vec<(Option<f64>, f64)> {
+    h1_crossings()
+        .into_iter()
+        .filter(|c| crossing || c.is_none())
+        .flat_map(|c| h1_ratios().into_iter().map(move |r| (c, r)))
+        .collect()
+}
+
+/// The spans of a column: all of [`h1_spans`], or, with a crossing test, those from
+/// [`crate::mapping::crossing::CROSSING_FLOOR`].
+fn column_spans(crossing: Option<f64>) -> Vec<f64> {
+    let floor = crate::mapping::crossing::CROSSING_FLOOR;
+    h1_spans()
+        .into_iter()
+        .filter(|&s| crossing.is_none() || s >= floor)
+        .collect()
+}
+
 /// The training windows with each component's sampling scale computed and its features
 /// split by dimension once: the grid search judges every sample at every grid point.
 struct Prepared<'a> {
     samples: &'a [Sample],
     scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>>,
+    /// Per sample and component: its H1 features with a life of at least
+    /// [`crate::mapping::crossing::CROSSING_FLOOR`] σ, the only ones a rule with a crossing
+    /// test can keep.
+    long: Vec<Vec<Vec<Feature>>>,
     /// Indices of the samples whose truth has no hole.
     holeless: Vec<usize>,
 }
 
 impl<'a> Prepared<'a> {
     fn new(samples: &'a [Sample]) -> Self {
-        let scaled = samples
+        let scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>> = samples
             .iter()
             .map(|s| {
                 s.components
@@ -126,12 +191,29 @@ impl<'a> Prepared<'a> {
                     .collect()
             })
             .collect();
+        let floor = crate::mapping::crossing::CROSSING_FLOOR;
+        let long = scaled
+            .iter()
+            .map(|comps| {
+                comps
+                    .iter()
+                    .map(|(sigma, fs)| {
+                        fs[1]
+                            .iter()
+                            .filter(|f| f.death - f.birth >= floor * sigma)
+                            .copied()
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
         let holeless = (0..samples.len())
             .filter(|&k| samples[k].truth[1] == 0)
             .collect();
         Self {
             samples,
             scaled,
+            long,
             holeless,
         }
     }
@@ -149,6 +231,47 @@ impl<'a> Prepared<'a> {
                 b == s.truth[dim]
             })
             .count()
+    }
+
+    /// One column of the H1 grid: for the rules with this crossing test and ratio and each
+    /// of `spans` (ascending), the samples whose β1 equals the truth and the hole-free
+    /// samples that show a hole, as judging every sample with [`Classifier::robust`] would.
+    /// A bar passing at some span passes at every smaller one, so each bar is placed once
+    /// by bisection on the rule itself: O(bars · log spans + samples · spans), not
+    /// O(bars · spans).
+    fn column(&self, crossing: Option<f64>, ratio: f64, spans: &[f64]) -> Vec<(usize, usize)> {
+        let rule = |h1_span: f64| Classifier {
+            h0_ratio: 0.0,
+            h1_ratio: ratio,
+            h1_span,
+            h1_crossing: crossing,
+        };
+        let rules: Vec<Classifier> = spans.iter().map(|&s| rule(s)).collect();
+        let mut out = vec![(0, 0); spans.len()];
+        let mut passing = vec![0usize; spans.len() + 1];
+        for (k, s) in self.samples.iter().enumerate() {
+            passing.iter_mut().for_each(|p| *p = 0);
+            for (c, (sigma, fs)) in self.scaled[k].iter().enumerate() {
+                let bars = if crossing.is_some() {
+                    &self.long[k][c]
+                } else {
+                    &fs[1]
+                };
+                for f in bars {
+                    // The number of leading spans at which `f` passes.
+                    let n = rules.partition_point(|r| r.robust(f, *sigma));
+                    passing[n] += 1;
+                }
+            }
+            // β1 at span i: the bars passing at more than i spans.
+            let mut b1 = 0;
+            for i in (0..spans.len()).rev() {
+                b1 += passing[i + 1];
+                out[i].0 += usize::from(b1 == s.truth[1]);
+                out[i].1 += usize::from(s.truth[1] == 0 && b1 > 0);
+            }
+        }
+        out
     }
 
     /// Hole-free samples in which `c` shows a hole.
@@ -178,6 +301,8 @@ impl<'a> Prepared<'a> {
 pub struct LandscapePoint {
     pub h1_ratio: f64,
     pub h1_span: f64,
+    /// The largest crossing share, or `None`: no crossing test.
+    pub h1_crossing: Option<f64>,
     /// Training windows whose β1 this rule gets right.
     pub b1_right: usize,
     /// Hole-free training windows in which it shows a hole.
@@ -190,26 +315,32 @@ pub struct LandscapePoint {
 /// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span): the
 /// landscape the fit maximises over, to see whether its optimum is a broad plateau or one
 /// of several near-equal peaks.
-pub fn h1_landscape(samples: &[Sample]) -> Vec<LandscapePoint> {
+pub fn h1_landscape(samples: &[Sample], crossing: bool) -> Vec<LandscapePoint> {
+    use rayon::prelude::*;
     let prepared = Prepared::new(samples);
-    let mut out = Vec::new();
-    for h1_ratio in h1_ratios() {
-        for h1_span in h1_spans() {
-            let c = Classifier {
-                h0_ratio: 0.0,
-                h1_ratio,
-                h1_span,
-            };
-            out.push(LandscapePoint {
-                h1_ratio,
-                h1_span,
-                b1_right: prepared.count(&|f, s| c.robust(f, s), 1),
-                false_holes: prepared.false_holes(&c),
-                false_share: prepared.false_share(&c),
-            });
-        }
-    }
-    out
+    let holeless = prepared.holeless.len();
+    h1_columns(crossing)
+        .par_iter()
+        .flat_map_iter(|&(h1_crossing, h1_ratio)| {
+            let spans = column_spans(h1_crossing);
+            let scores = prepared.column(h1_crossing, h1_ratio, &spans);
+            spans
+                .into_iter()
+                .zip(scores)
+                .map(move |(h1_span, (b1_right, false_holes))| LandscapePoint {
+                    h1_ratio,
+                    h1_span,
+                    h1_crossing,
+                    b1_right,
+                    false_holes,
+                    false_share: if holeless == 0 {
+                        0.0
+                    } else {
+                        false_holes as f64 / holeless as f64
+                    },
+                })
+        })
+        .collect()
 }
 
 /// Fits the three thresholds on `samples`. β0 and β1 are decided by disjoint parameters
@@ -217,7 +348,8 @@ pub fn h1_landscape(samples: &[Sample]) -> Vec<LandscapePoint> {
 /// reported accuracy is that of the combination. The H1 thresholds are searched only where at
 /// most `max_false_holes` of the windows without a true hole show one (see the module docs);
 /// `None` if no sample is given or no grid point meets the constraint.
-pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
+pub fn fit(samples: &[Sample], options: FitOptions) -> Option<Fit> {
+    let max_false_holes = options.max_false_holes;
     if samples.is_empty() {
         return None;
     }
@@ -227,6 +359,7 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
         h0_ratio: 0.0,
         h1_ratio: 0.0,
         h1_span: 0.0,
+        h1_crossing: None,
     };
     let best_middle = |scores: Vec<(Vec<f64>, usize)>| -> Vec<f64> {
         let top = scores.iter().map(|s| s.1).max().unwrap_or(0);
@@ -245,28 +378,43 @@ pub fn fit(samples: &[Sample], max_false_holes: f64) -> Option<Fit> {
         .collect();
     let h0_ratio = best_middle(h0)[0];
     let false_share = |c: &Classifier| prepared.false_share(c);
-    let mut h1 = Vec::new();
-    for r in h1_ratios() {
-        for span in h1_spans() {
+    let h1: Vec<(Classifier, usize)> = h1_landscape(samples, options.crossing)
+        .into_iter()
+        .filter(|p| p.false_share <= max_false_holes + 1e-12)
+        .map(|p| {
             let c = Classifier {
-                h1_ratio: r,
-                h1_span: span,
+                h1_ratio: p.h1_ratio,
+                h1_span: p.h1_span,
+                h1_crossing: p.h1_crossing,
                 ..base
             };
-            if false_share(&c) <= max_false_holes + 1e-12 {
-                h1.push((vec![r, span], count(&|f, s| c.robust(f, s), 1)));
-            }
-        }
-    }
-    if h1.is_empty() {
-        return None;
-    }
-    let best = best_middle(h1);
-    let classifier = Classifier {
-        h0_ratio,
-        h1_ratio: best[0],
-        h1_span: best[1],
+            (c, p.b1_right)
+        })
+        .collect();
+    let top = h1.iter().map(|s| s.1).max()?;
+    let winners: Vec<&Classifier> = h1.iter().filter(|s| s.1 == top).map(|s| &s.0).collect();
+    // A crossing test only where it scores more than none (then the old fit, unchanged);
+    // else the middle of the crossing values that reach the top, and within it the middle
+    // in (ratio, span) order.
+    let plain: Vec<&Classifier> = winners
+        .iter()
+        .copied()
+        .filter(|c| c.h1_crossing.is_none())
+        .collect();
+    let best = if plain.is_empty() {
+        let mut values: Vec<f64> = winners.iter().filter_map(|c| c.h1_crossing).collect();
+        values.dedup();
+        let x = values[values.len() / 2];
+        let at: Vec<&Classifier> = winners
+            .iter()
+            .copied()
+            .filter(|c| c.h1_crossing == Some(x))
+            .collect();
+        at[at.len() / 2]
+    } else {
+        plain[plain.len() / 2]
     };
+    let classifier = Classifier { h0_ratio, ..*best };
     let n = samples.len() as f64;
     let (mut ok, mut ok0, mut ok1) = (0, 0, 0);
     for s in samples {
@@ -325,8 +473,9 @@ pub struct CrossValidation {
 pub fn cross_validate(
     samples: &[Sample],
     groups: &[String],
-    max_false_holes: f64,
+    options: FitOptions,
 ) -> Result<CrossValidation, String> {
+    let max_false_holes = options.max_false_holes;
     assert_eq!(samples.len(), groups.len(), "one group label per sample");
     let mut labels: Vec<&String> = Vec::new();
     for g in groups {
@@ -351,7 +500,7 @@ pub fn cross_validate(
             .filter(|k| !in_fold(k))
             .map(|k| samples[k].clone())
             .collect();
-        let f = fit(&train, max_false_holes).ok_or_else(|| {
+        let f = fit(&train, options).ok_or_else(|| {
             format!(
                 "without {label}, no classifier shows false holes in at most {max_false_holes} \
                  of the training windows without a hole"
@@ -397,7 +546,7 @@ mod tests {
     use super::*;
 
     fn f(dim: usize, birth: f64, death: f64) -> Feature {
-        Feature { dim, birth, death }
+        Feature::bar(dim, birth, death)
     }
 
     /// Windows whose real holes have ratio 4 and noise ratio ≤ 2: the fit must separate them.
@@ -423,7 +572,7 @@ mod tests {
                 truth: [1, 0],
             });
         }
-        let fit = fit(&samples, 1.0).unwrap();
+        let fit = fit(&samples, FitOptions::cap(1.0)).unwrap();
         assert_eq!(fit.accuracy, 1.0, "{fit:?}");
         assert_eq!(fit.false_holes, 0.0);
         assert!(fit.classifier.h1_ratio > 2.0 && fit.classifier.h1_ratio <= 4.0);
@@ -447,14 +596,20 @@ mod tests {
                 truth: [1, usize::from(hole)],
             });
         }
-        let land = h1_landscape(&samples);
+        let land = h1_landscape(&samples, false);
         assert_eq!(land.len(), h1_ratios().len() * h1_spans().len());
+        let with: usize = h1_crossings()
+            .into_iter()
+            .map(|c| h1_ratios().len() * column_spans(c).len())
+            .sum();
+        assert_eq!(h1_landscape(&samples, true).len(), with);
         let holeless: Vec<&Sample> = samples.iter().filter(|s| s.truth[1] == 0).collect();
         for p in &land {
             let c = Classifier {
                 h0_ratio: 1e9,
                 h1_ratio: p.h1_ratio,
                 h1_span: p.h1_span,
+                h1_crossing: p.h1_crossing,
             };
             let right = samples
                 .iter()
@@ -466,7 +621,7 @@ mod tests {
             assert_eq!(p.false_share, shown as f64 / holeless.len() as f64, "{p:?}");
         }
         for cap in [0.0, 0.34, 1.0] {
-            let fit = fit(&samples, cap).unwrap();
+            let fit = fit(&samples, FitOptions::cap(cap)).unwrap();
             let best = land
                 .iter()
                 .filter(|p| p.false_share <= cap + 1e-12)
@@ -476,7 +631,9 @@ mod tests {
             let at = land
                 .iter()
                 .find(|p| {
-                    p.h1_ratio == fit.classifier.h1_ratio && p.h1_span == fit.classifier.h1_span
+                    p.h1_ratio == fit.classifier.h1_ratio
+                        && p.h1_span == fit.classifier.h1_span
+                        && p.h1_crossing == fit.classifier.h1_crossing
                 })
                 .unwrap();
             assert_eq!(at.b1_right, best, "cap {cap}: {fit:?}");
@@ -517,11 +674,11 @@ mod tests {
                 truth: [1, 0],
             },
         ];
-        let free = fit(&samples, 1.0).unwrap();
+        let free = fit(&samples, FitOptions::cap(1.0)).unwrap();
         assert_eq!(free.accuracy, 0.75, "{free:?}");
         // Unconstrained, the middle of the best plateau keeps the loop: the cap must bite.
         assert!(free.false_holes > 0.0, "{free:?}");
-        let strict = fit(&samples, 0.0).unwrap();
+        let strict = fit(&samples, FitOptions::cap(0.0)).unwrap();
         assert_eq!(strict.false_holes, 0.0, "{strict:?}");
         // Only the 6.0 hole survives a threshold above the 5.5 loop.
         assert_eq!(strict.accuracy, 0.75, "{strict:?}");
@@ -553,9 +710,9 @@ mod tests {
             window(1.0, 3.5, 0),
         ];
         let groups: Vec<String> = ["A", "A", "B", "B"].map(String::from).to_vec();
-        let all = fit(&samples, 1.0).unwrap();
+        let all = fit(&samples, FitOptions::cap(1.0)).unwrap();
         assert_eq!(all.accuracy, 0.75, "{all:?}");
-        let cv = cross_validate(&samples, &groups, 1.0).unwrap();
+        let cv = cross_validate(&samples, &groups, FitOptions::cap(1.0)).unwrap();
         assert_eq!(cv.folds.len(), 2);
         assert_eq!(cv.folds[0].held_out, "A");
         assert_eq!(
@@ -592,10 +749,62 @@ mod tests {
             samples.push(window(1.8, 0));
             groups.extend([format!("seed {g}"), format!("seed {g}")]);
         }
-        let cv = cross_validate(&samples, &groups, 0.0).unwrap();
+        let cv = cross_validate(&samples, &groups, FitOptions::cap(0.0)).unwrap();
         assert_eq!(cv.folds.len(), 3);
         assert_eq!((cv.accuracy, cv.false_holes), (1.0, 0.0), "{cv:?}");
-        let one = cross_validate(&samples[..2], &groups[..2], 0.0);
+        let one = cross_validate(&samples[..2], &groups[..2], FitOptions::cap(0.0));
         assert!(one.unwrap_err().contains("at least two groups"));
+    }
+
+    /// Real holes and noise loops with the same persistence (ratio 4, a life of 3 σ) but
+    /// crossing shares of 0.01 and 0.3: no (ratio, span) rule gets more than the hole-free
+    /// or the holed windows right, a crossing test gets all. The fit must take one between
+    /// the two shares; without shares (the same bars, `crossing: None`) it must take none.
+    #[test]
+    fn a_crossing_test_is_fitted_only_where_it_separates() {
+        let window = |loops: &[Option<f64>], hole: bool| {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            for &crossing in loops {
+                v.push(Feature {
+                    crossing,
+                    ..f(1, 1.0, 4.0)
+                });
+            }
+            Sample {
+                components: vec![v],
+                truth: [1, usize::from(hole)],
+            }
+        };
+        let mut samples = Vec::new();
+        for _ in 0..4 {
+            samples.push(window(&[Some(0.01)], true));
+            samples.push(window(&[Some(0.3)], false));
+        }
+        let options = FitOptions {
+            max_false_holes: 0.0,
+            crossing: true,
+        };
+        // Not asked for, no crossing test.
+        assert_eq!(
+            fit(&samples, FitOptions::cap(0.0))
+                .unwrap()
+                .classifier
+                .h1_crossing,
+            None
+        );
+        let fit = fit(&samples, options).unwrap();
+        assert_eq!(fit.accuracy, 1.0, "{fit:?}");
+        let max = fit.classifier.h1_crossing.expect("a crossing test");
+        assert!((0.01..0.3).contains(&max), "{max}");
+        // The middle of the grid's shares that separate them: all 24 do (0.01 to 0.2), and
+        // the 13th is 0.07.
+        assert_eq!(max, 0.07);
+        // Without shares no rule separates them; the plain rule that shows no false hole
+        // (cap 0) is kept, as before the crossing test existed.
+        let plain: Vec<Sample> = (0..8).map(|k| window(&[None], k % 2 == 0)).collect();
+        let fit = super::fit(&plain, options).unwrap();
+        assert_eq!(fit.classifier.h1_crossing, None);
+        assert_eq!(fit.false_holes, 0.0);
     }
 }

@@ -13,7 +13,9 @@
 //!   `h1_ratio` and its additive persistence `death − birth` is at least `h1_span · σ`.
 //!   The ratio is the standard scale-free noise test for Rips diagrams (noise loops die
 //!   shortly after they are born); the span rejects loops that are long-lived only
-//!   relative to a tiny birth.
+//!   relative to a tiny birth. A model may also carry `h1_crossing`: the largest share of
+//!   the agents' time lines near the loop's void that may pass through it
+//!   ([`super::crossing`]; none in the shipped models, README "Accuracy", step 37).
 //!
 //! The three thresholds are fitted by `swarmmap calibrate` on training worlds and shipped as
 //! the default models in `assets/classifier.json`. σ makes them free of the metric's unit
@@ -32,8 +34,14 @@ pub struct Classifier {
     pub h0_ratio: f64,
     /// An H1 class is robust if `death / birth ≥ h1_ratio` …
     pub h1_ratio: f64,
-    /// … and `death − birth ≥ h1_span · σ`.
+    /// … and `death − birth ≥ h1_span · σ` …
     pub h1_span: f64,
+    /// … and, when set, its crossing share ([`super::crossing`]) is at most this: few of
+    /// the agents' time lines pass through its void. Absent in models fitted without it
+    /// (every model before README "Accuracy", step 37) and in those of methods that
+    /// compute no share (`Paper`, the oracle): no such test.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub h1_crossing: Option<f64>,
 }
 
 /// The shipped models, one bank per mapping method (`assets/classifier.json`), each model
@@ -355,6 +363,16 @@ impl Models {
                         c.h1_span
                     );
                 }
+                if let Some(x) = c.h1_crossing
+                    && !(0.0..=1.0).contains(&x)
+                {
+                    anyhow::bail!(
+                        "{}: the {name} model's h1_crossing is {x}; it is the largest share of \
+                         time lines that may cross a hole, from 0 to 1 (or leave it out for no \
+                         crossing test)",
+                        path.display()
+                    );
+                }
                 if let Some(v) = m.leader_speed
                     && !(v.is_finite() && v > 0.0)
                 {
@@ -417,6 +435,20 @@ pub struct Feature {
     pub dim: usize,
     pub birth: f64,
     pub death: f64,
+    /// The crossing share of an H1 bar's void ([`super::crossing`]), where computed.
+    pub crossing: Option<f64>,
+}
+
+impl Feature {
+    /// A bar without a crossing share.
+    pub fn bar(dim: usize, birth: f64, death: f64) -> Self {
+        Self {
+            dim,
+            birth,
+            death,
+            crossing: None,
+        }
+    }
 }
 
 /// The features of a persistence diagram, one per bar, in the diagram's order.
@@ -424,11 +456,7 @@ pub fn features(diagram: &crate::topology::rips::Diagram) -> Vec<Feature> {
     diagram
         .bars
         .iter()
-        .map(|b| Feature {
-            dim: b.dim,
-            birth: b.birth,
-            death: b.death,
-        })
+        .map(|b| Feature::bar(b.dim, b.birth, b.death))
         .collect()
 }
 
@@ -480,11 +508,14 @@ impl Classifier {
         match f.dim {
             0 => f.death.is_infinite() || f.death > self.h0_ratio * sigma,
             1 => {
-                f.death.is_finite()
-                    && f.birth > 0.0
-                    && f.death / f.birth >= self.h1_ratio
-                    && f.death - f.birth >= self.h1_span * sigma
-                    || f.birth == 0.0 && f.death > self.h1_span * sigma
+                let crossed =
+                    matches!((self.h1_crossing, f.crossing), (Some(max), Some(x)) if x > max);
+                !crossed
+                    && (f.death.is_finite()
+                        && f.birth > 0.0
+                        && f.death / f.birth >= self.h1_ratio
+                        && f.death - f.birth >= self.h1_span * sigma
+                        || f.birth == 0.0 && f.death > self.h1_span * sigma)
             }
             _ => false,
         }
@@ -508,7 +539,7 @@ mod tests {
     use super::*;
 
     fn f(dim: usize, birth: f64, death: f64) -> Feature {
-        Feature { dim, birth, death }
+        Feature::bar(dim, birth, death)
     }
 
     #[test]
@@ -517,6 +548,7 @@ mod tests {
             h0_ratio: 5.0,
             h1_ratio: 2.0,
             h1_span: 3.0,
+            h1_crossing: None,
         };
         let diagram = vec![
             f(0, 0.0, 1.0),
@@ -556,6 +588,7 @@ mod tests {
                 h0_ratio: 50.0,
                 h1_ratio,
                 h1_span: 1.0,
+                h1_crossing: None,
             },
             fitted_on: format!("ratio {h1_ratio}"),
             events_per_point: density.map(|[min, median, max]| Density { min, median, max }),
@@ -687,6 +720,59 @@ mod tests {
         let text = serde_json::to_string(&two).unwrap();
         assert!(text.starts_with('['));
         assert_eq!(serde_json::from_str::<Bank>(&text).unwrap(), two);
+    }
+
+    /// The crossing test keeps an H1 bar only if its share is at most `h1_crossing`; a
+    /// bar without a share, or a model without the test, judges by persistence alone.
+    #[test]
+    fn the_crossing_test_gates_h1_only() {
+        let mut c = Classifier {
+            h0_ratio: 5.0,
+            h1_ratio: 2.0,
+            h1_span: 3.0,
+            h1_crossing: Some(0.05),
+        };
+        let with = |x: Option<f64>| Feature {
+            crossing: x,
+            ..f(1, 1.0, 5.0)
+        };
+        assert!(c.robust(&with(Some(0.05)), 1.0));
+        assert!(!c.robust(&with(Some(0.0500001)), 1.0));
+        assert!(c.robust(&with(None), 1.0));
+        // Persistence still decides first.
+        assert!(!c.robust(
+            &Feature {
+                crossing: Some(0.0),
+                ..f(1, 1.0, 1.9)
+            },
+            1.0
+        ));
+        // H0 ignores it.
+        assert!(c.robust(
+            &Feature {
+                crossing: Some(1.0),
+                ..f(0, 0.0, 6.0)
+            },
+            1.0
+        ));
+        // The candidate rule keeps the test.
+        assert_eq!(c.candidate().h1_crossing, Some(0.05));
+        c.h1_crossing = None;
+        assert!(c.robust(&with(Some(0.9)), 1.0));
+        // Written only when set, so model files without it read and write unchanged.
+        assert!(!serde_json::to_string(&c).unwrap().contains("crossing"));
+    }
+
+    #[test]
+    fn a_crossing_share_outside_0_to_1_is_refused() {
+        let mut m = Models::shipped();
+        m.embedded.0[0].classifier.h1_crossing = Some(1.5);
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("h1_crossing is 1.5"), "{err}");
+        m.embedded.0[0].classifier.h1_crossing = Some(0.04);
+        assert_eq!(load_text(&serde_json::to_string(&m).unwrap()).unwrap(), m);
     }
 
     fn load_text(text: &str) -> anyhow::Result<Models> {

@@ -189,7 +189,7 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
 /// superset of the 3-D ball's points), each pick updates the points of the grid cells
 /// within `r`, and a max-heap with lazy deletion (stale entries carry a larger distance
 /// than the point's current one) finds the next pick. About `π n ln m` evaluations for an
-/// even cloud; the picks are exactly those of the naive loop ([`maxmin_naive`], which the
+/// even cloud; the picks are exactly those of the naive loop (`maxmin_naive`, which the
 /// tests compare against).
 pub fn dense_maxmin(points: &[[f64; 3]], p: &DenseParams) -> Vec<usize> {
     let dims = p.dims.clamp(2, 3);

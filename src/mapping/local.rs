@@ -142,6 +142,11 @@ pub struct MapBar {
     /// robust or not (the global map weighs a hole two windows saw, `stitch`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub void: Option<[usize; 3]>,
+    /// For an H1 bar of the `Embedded` method with a life of at least
+    /// [`super::crossing::CROSSING_FLOOR`] σ, the share of the moving agents' time-line
+    /// segments near its void that pass through it ([`super::crossing`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crossing: Option<f64>,
 }
 
 /// A robust hole: its bar and a representative cycle as encounters (indices into the
@@ -432,7 +437,17 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
             noise[j] = false;
         }
         rows_out.extend(sub.picks.iter().copied().zip(sub.rows));
-        raw.push((members, diagram, reps, vertex_metric));
+        // The moving agents' time lines on the plane, for the bars' crossing shares: an
+        // agent is moving at an encounter unless it is a landmark then.
+        let lines = p.embedding_rips.is_some().then(|| {
+            super::crossing::TimeLines::new(&points, &enc, &members, |agent, j| {
+                !landmark_of.get(&agent).is_some_and(|v| {
+                    v.iter()
+                        .any(|&(start, end)| start <= enc[j].end && enc[j].start <= end)
+                })
+            })
+        });
+        raw.push((members, diagram, reps, vertex_metric, lines));
     }
     let vertices: usize = raw.iter().map(|r| r.2.len()).sum();
     let events_per_point = if vertices == 0 {
@@ -441,9 +456,24 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         mapped as f64 / vertices as f64
     };
     let classifier = p.classifier.pick(events_per_point).classifier;
-    for (members, diagram, reps, vertex_metric) in raw {
-        let features = super::classify::features(&diagram);
+    for (members, diagram, reps, vertex_metric, lines) in raw {
+        let mut features = super::classify::features(&diagram);
         let sigma = sampling_scale(&features);
+        if let Some(lines) = &lines {
+            let plane = |k: usize| [points[reps[k]][0], points[reps[k]][1]];
+            for (bar, f) in diagram.bars.iter().zip(features.iter_mut()) {
+                if f.dim != 1
+                    || !f.death.is_finite()
+                    || f.death - f.birth < super::crossing::CROSSING_FLOOR * sigma
+                {
+                    continue;
+                }
+                if let Some(t) = bar.death_triangle {
+                    let (centre, r) = super::crossing::void_disc(t.map(plane), f.death);
+                    f.crossing = lines.share(centre, r);
+                }
+            }
+        }
         let mut betti = [0, 0];
         let mut bars = Vec::new();
         let mut holes = Vec::new();
@@ -491,6 +521,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 } else {
                     None
                 },
+                crossing: f.crossing,
             });
         }
         components.push(Component {

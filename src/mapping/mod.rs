@@ -2,6 +2,7 @@
 
 pub mod bridge;
 pub mod classify;
+pub mod crossing;
 pub mod dense;
 pub mod encounter_graph;
 pub mod local;

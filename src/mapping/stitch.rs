@@ -731,6 +731,7 @@ mod tests {
                 h0_ratio: 57.5,
                 h1_ratio: 2.3,
                 h1_span: 4.25,
+                h1_crossing: None,
             },
             rows: Vec::new(),
         }
