@@ -252,7 +252,24 @@ fn crossing_adds_the_share_to_the_embedded_grid() {
                 && r[3] == c.h1_crossing.map_or(String::new(), |x| x.to_string())
         })
         .expect("the fitted rule is a grid point");
-    assert_eq!(row[0], "Embedded");
+    // It scores the most within the cap, and it has a crossing test only if no rule without
+    // one scores as much.
+    let right = |r: &Vec<&str>| r[5].parse::<usize>().unwrap();
+    let within: Vec<&Vec<&str>> = rows.iter().filter(|r| r[8] == "true").collect();
+    let best = within.iter().map(|r| right(r)).max().unwrap();
+    assert_eq!(right(row), best);
+    let plain_best = within
+        .iter()
+        .filter(|r| r[3].is_empty())
+        .map(|r| right(r))
+        .max()
+        .unwrap();
+    assert_eq!(c.h1_crossing.is_some(), plain_best < best, "{c:?}");
+    // The written model names the share exactly when it has one.
+    let text = std::fs::read_to_string(&out).unwrap();
+    let entry = &text[text.find("\"Embedded\"").unwrap()..];
+    let entry = &entry[..entry.find("\"Oracle\"").unwrap_or(entry.len())];
+    assert_eq!(entry.contains("h1_crossing"), c.h1_crossing.is_some());
 }
 
 /// One calibration fits the method's and the oracle's models from the same runs, and each

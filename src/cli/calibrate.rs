@@ -406,7 +406,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     {
         let options = FitOptions {
             max_false_holes: args.max_false_holes,
-            crossing: args.crossing && *method != Target::Oracle,
+            crossing: args.crossing && *method == Target::Method(MappingMethod::Embedded),
         };
         let f = fit(samples, options).ok_or_else(|| {
             input(anyhow!(
@@ -483,7 +483,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 Target::Method(_) => "",
             },
             if args.only { " --only" } else { "" },
-            if args.crossing && *method != Target::Oracle {
+            if args.crossing && *method == Target::Method(MappingMethod::Embedded) {
                 " --crossing"
             } else {
                 ""

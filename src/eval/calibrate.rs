@@ -18,7 +18,7 @@
 //!
 //! With `--crossing` ([`FitOptions::crossing`]) the H1 grid also runs over a largest crossing
 //! share ([`crate::mapping::crossing`]): no test, then 24 values (`h1_crossings`), each
-//! with the lives from [`crate::mapping::crossing::CROSSING_FLOOR`] σ. A crossing test is
+//! with the lives from [`crate::mapping::crossing::CROSSING_MIN_SPAN`] σ. A crossing test is
 //! kept only when it scores more than every rule without one, so on a tie the fit is the
 //! plain one; otherwise the middle of the shares that reach the top is taken, then the
 //! middle in (ratio, span) within it. The grid is scored column by column (one crossing
@@ -135,8 +135,9 @@ fn h1_spans() -> Vec<f64> {
 
 /// The H1 grid of [`fit`]: no crossing test, then a largest crossing share
 /// ([`crate::mapping::crossing`]) of 0.01 to 0.1 in steps of 0.005 and 0.12 to 0.2 in steps
-/// of 0.02. With a share, the life grid starts at [`crate::mapping::crossing::CROSSING_FLOOR`]
-/// σ: a bar below it has no share, so it would pass any share.
+/// of 0.02. With a share, the life grid starts at [`crate::mapping::crossing::CROSSING_MIN_SPAN`]
+/// σ, above [`crate::mapping::crossing::CROSSING_FLOOR`]: a bar below the floor has no
+/// share, so it would pass any share.
 fn h1_crossings() -> Vec<Option<f64>> {
     std::iter::once(None)
         .chain(grid(0.01, 0.1, 0.005).into_iter().map(Some))
@@ -155,9 +156,9 @@ fn h1_columns(crossing: bool) -> Vec<(Option<f64>, f64)> {
 }
 
 /// The spans of a column: all of [`h1_spans`], or, with a crossing test, those from
-/// [`crate::mapping::crossing::CROSSING_FLOOR`].
+/// [`crate::mapping::crossing::CROSSING_MIN_SPAN`].
 fn column_spans(crossing: Option<f64>) -> Vec<f64> {
-    let floor = crate::mapping::crossing::CROSSING_FLOOR;
+    let floor = crate::mapping::crossing::CROSSING_MIN_SPAN;
     h1_spans()
         .into_iter()
         .filter(|&s| crossing.is_none() || s >= floor)
@@ -170,8 +171,8 @@ struct Prepared<'a> {
     samples: &'a [Sample],
     scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>>,
     /// Per sample and component: its H1 features with a life of at least
-    /// [`crate::mapping::crossing::CROSSING_FLOOR`] σ, the only ones a rule with a crossing
-    /// test can keep.
+    /// [`crate::mapping::crossing::CROSSING_MIN_SPAN`] σ, the only ones a rule with a
+    /// crossing test can keep (the same expression as [`Classifier::robust`] at that span).
     long: Vec<Vec<Vec<Feature>>>,
     /// Indices of the samples whose truth has no hole.
     holeless: Vec<usize>,
@@ -191,7 +192,7 @@ impl<'a> Prepared<'a> {
                     .collect()
             })
             .collect();
-        let floor = crate::mapping::crossing::CROSSING_FLOOR;
+        let floor = crate::mapping::crossing::CROSSING_MIN_SPAN;
         let long = scaled
             .iter()
             .map(|comps| {
@@ -312,7 +313,8 @@ pub struct LandscapePoint {
     pub false_share: f64,
 }
 
-/// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span): the
+/// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span; with
+/// `crossing`, the rules without a crossing test first, then those of each share): the
 /// landscape the fit maximises over, to see whether its optimum is a broad plateau or one
 /// of several near-equal peaks.
 pub fn h1_landscape(samples: &[Sample], crossing: bool) -> Vec<LandscapePoint> {
@@ -639,6 +641,67 @@ mod tests {
             assert_eq!(at.b1_right, best, "cap {cap}: {fit:?}");
             assert_eq!(fit.b1_accuracy, best as f64 / samples.len() as f64);
         }
+    }
+
+    /// With crossing shares on the bars (lives on both sides of 1 σ, shares on both sides
+    /// of every grid value) every point of the crossing grid scores what judging each
+    /// window with `Classifier::robust` gives.
+    #[test]
+    fn the_crossing_landscape_scores_like_the_rule() {
+        let mut samples = Vec::new();
+        for k in 0..12 {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            let x = |j: usize| Some(0.004 + 0.0173 * ((k * 5 + j * 3) % 13) as f64);
+            v.push(Feature {
+                crossing: x(0),
+                ..f(1, 1.0, 1.4 + 0.35 * k as f64)
+            });
+            v.push(Feature {
+                crossing: x(1),
+                ..f(1, 0.5, 0.9 + 0.02 * k as f64)
+            });
+            v.push(Feature {
+                crossing: None,
+                ..f(1, 1.0, 1.5 + 0.05 * k as f64)
+            });
+            if k % 3 == 0 {
+                v.push(Feature {
+                    crossing: x(2),
+                    ..f(1, 0.8, 3.0 + 0.5 * k as f64)
+                });
+            }
+            samples.push(Sample {
+                components: vec![v],
+                truth: [1, usize::from(k % 3 == 0)],
+            });
+        }
+        let land = h1_landscape(&samples, true);
+        let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
+        let mut with_test = 0;
+        for p in &land {
+            let c = Classifier {
+                h0_ratio: 1e9,
+                h1_ratio: p.h1_ratio,
+                h1_span: p.h1_span,
+                h1_crossing: p.h1_crossing,
+            };
+            let right = samples
+                .iter()
+                .filter(|s| s.betti(&c)[1] == s.truth[1])
+                .count();
+            let shown = samples
+                .iter()
+                .filter(|s| s.truth[1] == 0 && s.betti(&c)[1] > 0)
+                .count();
+            assert_eq!((p.b1_right, p.false_holes), (right, shown), "{p:?}");
+            assert_eq!(p.false_share, shown as f64 / holeless as f64);
+            with_test += usize::from(p.h1_crossing.is_some());
+        }
+        assert_eq!(
+            with_test,
+            24 * h1_ratios().len() * column_spans(Some(0.1)).len()
+        );
     }
 
     /// A hole-free window holds a noise loop (ratio 5.5) between the two real holes (ratios

@@ -739,7 +739,7 @@ mod tests {
         assert!(c.robust(&with(Some(0.05)), 1.0));
         assert!(!c.robust(&with(Some(0.0500001)), 1.0));
         assert!(c.robust(&with(None), 1.0));
-        // Persistence still decides first.
+        // Persistence must pass too.
         assert!(!c.robust(
             &Feature {
                 crossing: Some(0.0),

@@ -30,7 +30,7 @@
 //! loses scenario 3's small obstacles).
 //!
 //! Cost: O(s) per bar for s segments (two per encounter at most); computed only for bars
-//! whose life is at least [`CROSSING_FLOOR`] σ, 40–150 per window on the bundled worlds.
+//! whose life is at least [`CROSSING_FLOOR`] σ, a few hundred per window on the bundled worlds.
 
 use crate::log::Encounter;
 
@@ -40,9 +40,15 @@ pub const CORE: f64 = 0.5;
 /// Segments with an end within `NEAR · r` of the void's centre are the ones that could.
 pub const NEAR: f64 = 2.0;
 
-/// Bars with a life below `CROSSING_FLOOR · σ` get no share (no classifier the fit can
-/// choose keeps them; the fit's smallest life on the training worlds is several σ).
-pub const CROSSING_FLOOR: f64 = 1.0;
+/// The smallest life, in σ, that a rule with a crossing test may ask
+/// (`swarmmap calibrate --crossing` searches lives from it).
+pub const CROSSING_MIN_SPAN: f64 = 1.0;
+
+/// Bars with a life below `CROSSING_FLOOR · σ` get no share, and pass any crossing test.
+/// It is the candidate test's share ([`super::classify::CANDIDATE_SHARE`]) of
+/// [`CROSSING_MIN_SPAN`], so every bar that a rule with a crossing test, or its candidate
+/// test, can keep has a share.
+pub const CROSSING_FLOOR: f64 = 0.75;
 
 /// The time-line segments of a component's moving agents on the plane of its cloud.
 #[derive(Debug, Clone, Default)]
