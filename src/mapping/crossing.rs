@@ -30,7 +30,8 @@
 //! loses scenario 3's small obstacles).
 //!
 //! Cost: O(s) per bar for s segments (two per encounter at most); computed only for bars
-//! whose life is at least [`CROSSING_FLOOR`] σ, a few hundred per window on the bundled worlds.
+//! whose life is at least [`CROSSING_FLOOR`] σ: 95–124 per window of scenario 2, 225–270 of
+//! scenario 3 (seed 1, seed 7).
 
 use crate::log::Encounter;
 
