@@ -580,6 +580,27 @@ mod tests {
         assert!(fit.classifier.h1_ratio > 2.0 && fit.classifier.h1_ratio <= 4.0);
     }
 
+    /// Every point of `land` scores what judging each of `samples` with its rule gives.
+    fn scores_like_the_rule(samples: &[Sample], land: &[LandscapePoint]) {
+        let holeless: Vec<&Sample> = samples.iter().filter(|s| s.truth[1] == 0).collect();
+        for p in land {
+            let c = Classifier {
+                h0_ratio: 1e9,
+                h1_ratio: p.h1_ratio,
+                h1_span: p.h1_span,
+                h1_crossing: p.h1_crossing,
+            };
+            let right = samples
+                .iter()
+                .filter(|s| s.betti(&c)[1] == s.truth[1])
+                .count();
+            let shown = holeless.iter().filter(|s| s.betti(&c)[1] > 0).count();
+            assert_eq!(p.b1_right, right, "{p:?}");
+            assert_eq!(p.false_holes, shown, "{p:?}");
+            assert_eq!(p.false_share, shown as f64 / holeless.len() as f64, "{p:?}");
+        }
+    }
+
     /// The landscape scores every grid point as judging each window one by one would, and
     /// the fit's thresholds lie on its best point within the cap.
     #[test]
@@ -605,23 +626,7 @@ mod tests {
             .map(|c| h1_ratios().len() * column_spans(c).len())
             .sum();
         assert_eq!(h1_landscape(&samples, true).len(), with);
-        let holeless: Vec<&Sample> = samples.iter().filter(|s| s.truth[1] == 0).collect();
-        for p in &land {
-            let c = Classifier {
-                h0_ratio: 1e9,
-                h1_ratio: p.h1_ratio,
-                h1_span: p.h1_span,
-                h1_crossing: p.h1_crossing,
-            };
-            let right = samples
-                .iter()
-                .filter(|s| s.betti(&c)[1] == s.truth[1])
-                .count();
-            let shown = holeless.iter().filter(|s| s.betti(&c)[1] > 0).count();
-            assert_eq!(p.b1_right, right, "{p:?}");
-            assert_eq!(p.false_holes, shown, "{p:?}");
-            assert_eq!(p.false_share, shown as f64 / holeless.len() as f64, "{p:?}");
-        }
+        scores_like_the_rule(&samples, &land);
         for cap in [0.0, 0.34, 1.0] {
             let fit = fit(&samples, FitOptions::cap(cap)).unwrap();
             let best = land
@@ -677,27 +682,8 @@ mod tests {
             });
         }
         let land = h1_landscape(&samples, true);
-        let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
-        let mut with_test = 0;
-        for p in &land {
-            let c = Classifier {
-                h0_ratio: 1e9,
-                h1_ratio: p.h1_ratio,
-                h1_span: p.h1_span,
-                h1_crossing: p.h1_crossing,
-            };
-            let right = samples
-                .iter()
-                .filter(|s| s.betti(&c)[1] == s.truth[1])
-                .count();
-            let shown = samples
-                .iter()
-                .filter(|s| s.truth[1] == 0 && s.betti(&c)[1] > 0)
-                .count();
-            assert_eq!((p.b1_right, p.false_holes), (right, shown), "{p:?}");
-            assert_eq!(p.false_share, shown as f64 / holeless as f64);
-            with_test += usize::from(p.h1_crossing.is_some());
-        }
+        scores_like_the_rule(&samples, &land);
+        let with_test = land.iter().filter(|p| p.h1_crossing.is_some()).count();
         assert_eq!(
             with_test,
             24 * h1_ratios().len() * column_spans(Some(0.1)).len()
