@@ -184,22 +184,23 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
     assert_eq!(
         lines.next(),
         Some(
-            "method,h1_ratio,h1_span,h1_crossing,windows,b1_right,holeless,false_holes,within_cap"
+            "method,h1_ratio,h1_span,h1_crossing,h1_stability,windows,b1_right,holeless,false_holes,within_cap"
         )
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     // Death / birth 1 to 8 in steps of 0.1, a life of 0 to 20 σ in steps of 0.25 σ; no
-    // crossing test without `--crossing`.
+    // crossing or stability test without `--crossing` / `--stability`.
     assert_eq!(rows.len(), 71 * 81);
-    assert!(
-        rows.iter()
-            .all(|r| r.len() == 9 && r[0] == "Paper" && r[3].is_empty() && r[4] == "4")
-    );
+    assert!(rows.iter().all(|r| r.len() == 10
+        && r[0] == "Paper"
+        && r[3].is_empty()
+        && r[4].is_empty()
+        && r[5] == "4"));
     // Unconstrained, every point is within the cap, and the fitted rule scores the most.
-    assert!(rows.iter().all(|r| r[8] == "true"));
+    assert!(rows.iter().all(|r| r[9] == "true"));
     let best = rows
         .iter()
-        .map(|r| r[5].parse::<usize>().unwrap())
+        .map(|r| r[6].parse::<usize>().unwrap())
         .max()
         .unwrap();
     let c = models(&out).paper.first().classifier;
@@ -209,7 +210,7 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
             r[1].parse::<f64>().unwrap() == c.h1_ratio && r[2].parse::<f64>().unwrap() == c.h1_span
         })
         .expect("the fitted rule is a grid point");
-    assert_eq!(fitted[5].parse::<usize>().unwrap(), best);
+    assert_eq!(fitted[6].parse::<usize>().unwrap(), best);
 }
 
 /// With `--crossing` the `Embedded` method's grid also runs over the largest crossing share
@@ -254,8 +255,8 @@ fn crossing_adds_the_share_to_the_embedded_grid() {
         .expect("the fitted rule is a grid point");
     // It scores the most within the cap, and it has a crossing test only if no rule without
     // one scores as much.
-    let right = |r: &Vec<&str>| r[5].parse::<usize>().unwrap();
-    let within: Vec<&Vec<&str>> = rows.iter().filter(|r| r[8] == "true").collect();
+    let right = |r: &Vec<&str>| r[6].parse::<usize>().unwrap();
+    let within: Vec<&Vec<&str>> = rows.iter().filter(|r| r[9] == "true").collect();
     let best = within.iter().map(|r| right(r)).max().unwrap();
     assert_eq!(right(row), best);
     let plain_best = within
@@ -270,6 +271,78 @@ fn crossing_adds_the_share_to_the_embedded_grid() {
     let entry = &text[text.find("\"Embedded\"").unwrap()..];
     let entry = &entry[..entry.find("\"Oracle\"").unwrap_or(entry.len())];
     assert_eq!(entry.contains("h1_crossing"), c.h1_crossing.is_some());
+}
+
+/// With `--stability` the `Embedded` method's training runs record split stabilities, the
+/// grid also runs over the least stability (31 values, each with the lives from 1 σ), and
+/// the model it writes carries `h1_stability` exactly when its rule has one.
+#[test]
+fn stability_adds_the_split_stability_to_the_embedded_grid() {
+    let (dir, out) = shipped_copy();
+    let land = dir.path().join("landscape.csv");
+    let stdout = calibrate(
+        &out,
+        &[
+            "--stability",
+            "--set",
+            "mapping.method=Embedded",
+            "--landscape",
+            land.to_str().unwrap(),
+        ],
+    );
+    assert!(stdout.contains("h1_stability"), "{stdout}");
+    let text = std::fs::read_to_string(&land).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 71 * 81 + 31 * 71 * 77);
+    let values: std::collections::BTreeSet<&str> = rows.iter().map(|r| r[4]).collect();
+    assert_eq!(values.len(), 32, "{values:?}");
+    assert!(values.contains("") && values.contains("0.5") && values.contains("8"));
+    assert!(
+        rows.iter().all(|r| r[3].is_empty()),
+        "no crossing test asked"
+    );
+    // Stabilities were computed: some rule with a stability test scores differently from
+    // the same rule without one.
+    let score = |r: &Vec<&str>| format!("{},{},{}", r[1], r[2], r[6]);
+    let plain: std::collections::BTreeSet<String> =
+        rows.iter().filter(|r| r[4].is_empty()).map(score).collect();
+    assert!(
+        rows.iter()
+            .filter(|r| r[4] == "8")
+            .any(|r| !plain.contains(&score(r))),
+        "a stability of at least 8 σ changes no score: were stabilities recorded?"
+    );
+    let m = models(&out);
+    let fit = &m.embedded.for_sweep(TINY_SWEEP).0[0];
+    assert!(fit.fitted_on.contains(" --stability "), "{}", fit.fitted_on);
+    let c = fit.classifier;
+    let row = rows
+        .iter()
+        .find(|r| {
+            r[1].parse::<f64>().unwrap() == c.h1_ratio
+                && r[2].parse::<f64>().unwrap() == c.h1_span
+                && r[4] == c.h1_stability.map_or(String::new(), |x| x.to_string())
+        })
+        .expect("the fitted rule is a grid point");
+    let right = |r: &Vec<&str>| r[6].parse::<usize>().unwrap();
+    let within: Vec<&Vec<&str>> = rows.iter().filter(|r| r[9] == "true").collect();
+    let best = within.iter().map(|r| right(r)).max().unwrap();
+    assert_eq!(right(row), best);
+    let plain_best = within
+        .iter()
+        .filter(|r| r[4].is_empty())
+        .map(|r| right(r))
+        .max()
+        .unwrap();
+    assert_eq!(c.h1_stability.is_some(), plain_best < best, "{c:?}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let entry = &text[text.find("\"Embedded\"").unwrap()..];
+    let entry = &entry[..entry.find("\"Oracle\"").unwrap_or(entry.len())];
+    assert_eq!(entry.contains("h1_stability"), c.h1_stability.is_some());
 }
 
 /// One calibration fits the method's and the oracle's models from the same runs, and each

@@ -60,6 +60,13 @@ pub struct CalibrateArgs {
     /// `Embedded` method; a crossing test is kept only where it scores more than none.
     #[arg(long)]
     pub crossing: bool,
+    /// Also search a least split stability for H1 (`h1_stability`: the life, in σ, of the
+    /// weaker of the loops that the two halves of a window's encounters show at a hole's
+    /// place, "Mapping"), for the `Embedded` method; implies `--set
+    /// mapping.split_stability=true` for the training runs; a stability test is kept only
+    /// where it scores more than none.
+    #[arg(long)]
+    pub stability: bool,
     /// Also estimate the fit's accuracy on windows it was not fitted on: hold out each seed
     /// (or each world) in turn, fit on the rest under the same cap, judge the held-out
     /// windows. Repeat the option for both. The model written is still the fit on all.
@@ -103,8 +110,10 @@ struct StoredWindow {
     components: Vec<Vec<StoredBar>>,
 }
 
-/// A bar as `--runs` keeps it: `(dim, birth, death, crossing share)`, numbers as bits.
-type StoredBar = (usize, u64, Option<u64>, Option<u64>);
+/// A bar as `--runs` keeps it: `(dim, birth, death, crossing share, stability)`, numbers
+/// as bits. (A file of an earlier build, without the stability, does not read as a run and
+/// is run again.)
+type StoredBar = (usize, u64, Option<u64>, Option<u64>, Option<u64>);
 
 impl StoredWindow {
     fn from_sample(s: &Sample) -> Self {
@@ -122,6 +131,7 @@ impl StoredWindow {
                                 f.birth.to_bits(),
                                 death,
                                 f.crossing.map(f64::to_bits),
+                                f.stability.map(f64::to_bits),
                             )
                         })
                         .collect()
@@ -138,11 +148,12 @@ impl StoredWindow {
                 .iter()
                 .map(|c| {
                     c.iter()
-                        .map(|&(dim, birth, death, crossing)| Feature {
+                        .map(|&(dim, birth, death, crossing, stability)| Feature {
                             dim,
                             birth: f64::from_bits(birth),
                             death: death.map_or(f64::INFINITY, f64::from_bits),
                             crossing: crossing.map(f64::from_bits),
+                            stability: stability.map(f64::from_bits),
                         })
                         .collect()
                 })
@@ -203,9 +214,14 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             "no training worlds: give world files or add worlds/training/*.ron"
         )));
     }
+    // `--stability` needs the bars' stabilities from the training runs.
+    let mut set = args.set.clone();
+    if args.stability && !set.iter().any(|s| s.starts_with("mapping.split_stability")) {
+        set.push("mapping.split_stability=true".to_string());
+    }
     let worlds: Vec<World> = paths
         .iter()
-        .map(|p| load_world(p, &args.set))
+        .map(|p| load_world(p, &set))
         .collect::<Result<_, _>>()?;
     // A model is tied to one sweep speed (`Bank::for_sweep`): the training runs share it.
     let sweep = worlds[0].leader.speed;
@@ -246,7 +262,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     .with_context(|| format!("reading {}", path.display()))
                     .map_err(input)?;
                 let mut parts = text.into_bytes();
-                for s in &args.set {
+                for s in &set {
                     parts.extend_from_slice(s.as_bytes());
                     parts.push(0);
                 }
@@ -395,7 +411,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     // One file for every method fitted (`--landscape`), written once at the end.
     let mut csv = String::from(
-        "method,h1_ratio,h1_span,h1_crossing,windows,b1_right,holeless,false_holes,within_cap\n",
+        "method,h1_ratio,h1_span,h1_crossing,h1_stability,windows,b1_right,holeless,false_holes,within_cap\n",
     );
     for Training {
         target: method,
@@ -407,6 +423,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         let options = FitOptions {
             max_false_holes: args.max_false_holes,
             crossing: args.crossing && *method == Target::Method(MappingMethod::Embedded),
+            stability: args.stability && *method == Target::Method(MappingMethod::Embedded),
         };
         let f = fit(samples, options).ok_or_else(|| {
             input(anyhow!(
@@ -417,13 +434,14 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             ))
         })?;
         println!(
-            "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}; training windows {}: \
+            "{}: h0_ratio {:.2}, h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}, h1_stability {}; training windows {}: \
              both right {:.1} %, β0 {:.1} %, β1 {:.1} %, false holes {:.1} % of hole-free windows",
             target_name(method),
             f.classifier.h0_ratio,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
             crossing_text(f.classifier.h1_crossing),
+            stability_text(f.classifier.h1_stability),
             f.windows,
             100.0 * f.accuracy,
             100.0 * f.b0_accuracy,
@@ -432,13 +450,14 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         );
         if args.landscape.is_some() {
             let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
-            for p in h1_landscape(samples, options.crossing) {
+            for p in h1_landscape(samples, options) {
                 csv.push_str(&format!(
-                    "{},{},{},{},{},{},{},{},{}\n",
+                    "{},{},{},{},{},{},{},{},{},{}\n",
                     target_name(method),
                     p.h1_ratio,
                     p.h1_span,
                     p.h1_crossing.map_or(String::new(), |x| x.to_string()),
+                    p.h1_stability.map_or(String::new(), |x| x.to_string()),
                     samples.len(),
                     p.b1_right,
                     holeless,
@@ -477,7 +496,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             );
         }
         let fitted_on = format!(
-            "swarmmap calibrate{}{}{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
+            "swarmmap calibrate{}{}{}{} --seeds {} --max-false-holes {} {}{}{}: {} windows, {:.1} % right (β0 {:.1} %, β1 {:.1} %, false holes in {:.1} % of hole-free windows)",
             match method {
                 Target::Oracle => " --oracle",
                 Target::Method(_) => "",
@@ -485,6 +504,11 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             if args.only { " --only" } else { "" },
             if args.crossing && *method == Target::Method(MappingMethod::Embedded) {
                 " --crossing"
+            } else {
+                ""
+            },
+            if args.stability && *method == Target::Method(MappingMethod::Embedded) {
+                " --stability"
             } else {
                 ""
             },
@@ -563,11 +587,12 @@ fn print_cross_validation(groups: CvGroups, cv: &CrossValidation) {
     );
     for f in &cv.folds {
         println!(
-            "    without {:<12} h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}, h0_ratio {:.2}: {}/{} right, false holes {}/{}",
+            "    without {:<12} h1_ratio {:.2}, h1_span {:.2}, h1_crossing {}, h1_stability {}, h0_ratio {:.2}: {}/{} right, false holes {}/{}",
             f.held_out,
             f.classifier.h1_ratio,
             f.classifier.h1_span,
             crossing_text(f.classifier.h1_crossing),
+            stability_text(f.classifier.h1_stability),
             f.classifier.h0_ratio,
             f.right,
             f.windows,
@@ -606,4 +631,9 @@ fn target_name(target: &Target) -> String {
 /// A model's largest crossing share as printed: the value, or `none` (no crossing test).
 fn crossing_text(c: Option<f64>) -> String {
     c.map_or_else(|| "none".to_string(), |x| format!("{x:.3}"))
+}
+
+/// A model's least split stability as printed: the value, or `none` (no stability test).
+fn stability_text(c: Option<f64>) -> String {
+    c.map_or_else(|| "none".to_string(), |x| format!("{x:.2}"))
 }

@@ -58,6 +58,7 @@ impl Sample {
                         .iter()
                         .map(|b| Feature {
                             crossing: b.crossing,
+                            stability: b.stability,
                             ..Feature::bar(b.dim, b.birth, b.death.unwrap_or(f64::INFINITY))
                         })
                         .collect()
@@ -102,6 +103,10 @@ pub struct FitOptions {
     /// Off by default: on the training worlds it gains 4 of 450 windows and carries worse
     /// to unseen ones (README "Accuracy", step 37).
     pub crossing: bool,
+    /// Also search a least split stability (`h1_stabilities`; `calibrate --stability`).
+    /// The training windows' bars need stabilities: map them with
+    /// `mapping.split_stability` (README "Accuracy", step 39).
+    pub stability: bool,
 }
 
 impl FitOptions {
@@ -110,6 +115,7 @@ impl FitOptions {
         Self {
             max_false_holes,
             crossing: false,
+            stability: false,
         }
     }
 }
@@ -145,23 +151,57 @@ fn h1_crossings() -> Vec<Option<f64>> {
         .collect()
 }
 
-/// The columns of [`fit`]'s H1 grid, in grid order (crossing, then ratio); each column
-/// runs over its spans ([`Prepared::column`]).
-fn h1_columns(crossing: bool) -> Vec<(Option<f64>, f64)> {
-    h1_crossings()
-        .into_iter()
-        .filter(|c| crossing || c.is_none())
-        .flat_map(|c| h1_ratios().into_iter().map(move |r| (c, r)))
+/// The H1 grid of [`fit`]: no stability test, then a least split stability
+/// ([`crate::mapping::stability`]) of 0.5 to 8 in steps of 0.25 (lives in σ of the halves).
+/// With a stability, the life grid starts at [`crate::mapping::crossing::CROSSING_MIN_SPAN`]
+/// σ, as with a crossing share and for the same reason.
+fn h1_stabilities() -> Vec<Option<f64>> {
+    std::iter::once(None)
+        .chain(grid(0.5, 8.0, 0.25).into_iter().map(Some))
         .collect()
 }
 
-/// The spans of a column: all of [`h1_spans`], or, with a crossing test, those from
-/// [`crate::mapping::crossing::CROSSING_MIN_SPAN`].
-fn column_spans(crossing: Option<f64>) -> Vec<f64> {
+/// The tests beyond persistence of an H1 rule: its largest crossing share and its least
+/// split stability (`None`: no such test).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Gates {
+    crossing: Option<f64>,
+    stability: Option<f64>,
+}
+
+impl Gates {
+    fn any(&self) -> bool {
+        self.crossing.is_some() || self.stability.is_some()
+    }
+}
+
+/// The columns of [`fit`]'s H1 grid, in grid order (crossing, then stability, then ratio);
+/// each column runs over its spans ([`Prepared::column`]).
+fn h1_columns(options: FitOptions) -> Vec<(Gates, f64)> {
+    let stabilities: Vec<Option<f64>> = h1_stabilities()
+        .into_iter()
+        .filter(|s| options.stability || s.is_none())
+        .collect();
+    h1_crossings()
+        .into_iter()
+        .filter(|c| options.crossing || c.is_none())
+        .flat_map(|crossing| {
+            stabilities.iter().map(move |&stability| Gates {
+                crossing,
+                stability,
+            })
+        })
+        .flat_map(|g| h1_ratios().into_iter().map(move |r| (g, r)))
+        .collect()
+}
+
+/// The spans of a column: all of [`h1_spans`], or, with a crossing or stability test,
+/// those from [`crate::mapping::crossing::CROSSING_MIN_SPAN`].
+fn column_spans(gates: Gates) -> Vec<f64> {
     let floor = crate::mapping::crossing::CROSSING_MIN_SPAN;
     h1_spans()
         .into_iter()
-        .filter(|&s| crossing.is_none() || s >= floor)
+        .filter(|&s| !gates.any() || s >= floor)
         .collect()
 }
 
@@ -172,7 +212,8 @@ struct Prepared<'a> {
     scaled: Vec<Vec<(f64, [Vec<Feature>; 2])>>,
     /// Per sample and component: its H1 features with a life of at least
     /// [`crate::mapping::crossing::CROSSING_MIN_SPAN`] σ, the only ones a rule with a
-    /// crossing test can keep (the same expression as [`Classifier::robust`] at that span).
+    /// crossing or stability test can keep (the same expression as [`Classifier::robust`]
+    /// at that span).
     long: Vec<Vec<Vec<Feature>>>,
     /// Indices of the samples whose truth has no hole.
     holeless: Vec<usize>,
@@ -234,18 +275,19 @@ impl<'a> Prepared<'a> {
             .count()
     }
 
-    /// One column of the H1 grid: for the rules with this crossing test and ratio and each
+    /// One column of the H1 grid: for the rules with these gates and ratio and each
     /// of `spans` (ascending), the samples whose β1 equals the truth and the hole-free
     /// samples that show a hole, as judging every sample with [`Classifier::robust`] would.
     /// A bar passing at some span passes at every smaller one, so each bar is placed once
     /// by bisection on the rule itself: O(bars · log spans + samples · spans), not
     /// O(bars · spans).
-    fn column(&self, crossing: Option<f64>, ratio: f64, spans: &[f64]) -> Vec<(usize, usize)> {
+    fn column(&self, gates: Gates, ratio: f64, spans: &[f64]) -> Vec<(usize, usize)> {
         let rule = |h1_span: f64| Classifier {
             h0_ratio: 0.0,
             h1_ratio: ratio,
             h1_span,
-            h1_crossing: crossing,
+            h1_crossing: gates.crossing,
+            h1_stability: gates.stability,
         };
         let rules: Vec<Classifier> = spans.iter().map(|&s| rule(s)).collect();
         let mut out = vec![(0, 0); spans.len()];
@@ -253,7 +295,7 @@ impl<'a> Prepared<'a> {
         for (k, s) in self.samples.iter().enumerate() {
             passing.iter_mut().for_each(|p| *p = 0);
             for (c, (sigma, fs)) in self.scaled[k].iter().enumerate() {
-                let bars = if crossing.is_some() {
+                let bars = if gates.any() {
                     &self.long[k][c]
                 } else {
                     &fs[1]
@@ -304,6 +346,8 @@ pub struct LandscapePoint {
     pub h1_span: f64,
     /// The largest crossing share, or `None`: no crossing test.
     pub h1_crossing: Option<f64>,
+    /// The least split stability, or `None`: no stability test.
+    pub h1_stability: Option<f64>,
     /// Training windows whose β1 this rule gets right.
     pub b1_right: usize,
     /// Hole-free training windows in which it shows a hole.
@@ -314,25 +358,26 @@ pub struct LandscapePoint {
 }
 
 /// Every point of [`fit`]'s H1 grid with its score, in grid order (ratio, then span; with
-/// `crossing`, the rules without a crossing test first, then those of each share): the
-/// landscape the fit maximises over, to see whether its optimum is a broad plateau or one
-/// of several near-equal peaks.
-pub fn h1_landscape(samples: &[Sample], crossing: bool) -> Vec<LandscapePoint> {
+/// `options.crossing` / `options.stability`, the rules without such a test first, then
+/// those of each share and stability): the landscape the fit maximises over, to see
+/// whether its optimum is a broad plateau or one of several near-equal peaks.
+pub fn h1_landscape(samples: &[Sample], options: FitOptions) -> Vec<LandscapePoint> {
     use rayon::prelude::*;
     let prepared = Prepared::new(samples);
     let holeless = prepared.holeless.len();
-    h1_columns(crossing)
+    h1_columns(options)
         .par_iter()
-        .flat_map_iter(|&(h1_crossing, h1_ratio)| {
-            let spans = column_spans(h1_crossing);
-            let scores = prepared.column(h1_crossing, h1_ratio, &spans);
+        .flat_map_iter(|&(gates, h1_ratio)| {
+            let spans = column_spans(gates);
+            let scores = prepared.column(gates, h1_ratio, &spans);
             spans
                 .into_iter()
                 .zip(scores)
                 .map(move |(h1_span, (b1_right, false_holes))| LandscapePoint {
                     h1_ratio,
                     h1_span,
-                    h1_crossing,
+                    h1_crossing: gates.crossing,
+                    h1_stability: gates.stability,
                     b1_right,
                     false_holes,
                     false_share: if holeless == 0 {
@@ -362,6 +407,7 @@ pub fn fit(samples: &[Sample], options: FitOptions) -> Option<Fit> {
         h1_ratio: 0.0,
         h1_span: 0.0,
         h1_crossing: None,
+        h1_stability: None,
     };
     let best_middle = |scores: Vec<(Vec<f64>, usize)>| -> Vec<f64> {
         let top = scores.iter().map(|s| s.1).max().unwrap_or(0);
@@ -380,7 +426,7 @@ pub fn fit(samples: &[Sample], options: FitOptions) -> Option<Fit> {
         .collect();
     let h0_ratio = best_middle(h0)[0];
     let false_share = |c: &Classifier| prepared.false_share(c);
-    let h1: Vec<(Classifier, usize)> = h1_landscape(samples, options.crossing)
+    let h1: Vec<(Classifier, usize)> = h1_landscape(samples, options)
         .into_iter()
         .filter(|p| p.false_share <= max_false_holes + 1e-12)
         .map(|p| {
@@ -388,6 +434,7 @@ pub fn fit(samples: &[Sample], options: FitOptions) -> Option<Fit> {
                 h1_ratio: p.h1_ratio,
                 h1_span: p.h1_span,
                 h1_crossing: p.h1_crossing,
+                h1_stability: p.h1_stability,
                 ..base
             };
             (c, p.b1_right)
@@ -395,23 +442,23 @@ pub fn fit(samples: &[Sample], options: FitOptions) -> Option<Fit> {
         .collect();
     let top = h1.iter().map(|s| s.1).max()?;
     let winners: Vec<&Classifier> = h1.iter().filter(|s| s.1 == top).map(|s| &s.0).collect();
-    // A crossing test only where it scores more than none (then the old fit, unchanged);
-    // else the middle of the crossing values that reach the top, and within it the middle
-    // in (ratio, span) order.
+    // A crossing or stability test only where it scores more than none (then the old
+    // fit, unchanged); else the middle of the gates (crossing share, then stability, in
+    // grid order) that reach the top, and within them the middle in (ratio, span) order.
+    let gates = |c: &Classifier| Gates {
+        crossing: c.h1_crossing,
+        stability: c.h1_stability,
+    };
     let plain: Vec<&Classifier> = winners
         .iter()
         .copied()
-        .filter(|c| c.h1_crossing.is_none())
+        .filter(|c| !gates(c).any())
         .collect();
     let best = if plain.is_empty() {
-        let mut values: Vec<f64> = winners.iter().filter_map(|c| c.h1_crossing).collect();
+        let mut values: Vec<Gates> = winners.iter().map(|c| gates(c)).collect();
         values.dedup();
         let x = values[values.len() / 2];
-        let at: Vec<&Classifier> = winners
-            .iter()
-            .copied()
-            .filter(|c| c.h1_crossing == Some(x))
-            .collect();
+        let at: Vec<&Classifier> = winners.iter().copied().filter(|c| gates(c) == x).collect();
         at[at.len() / 2]
     } else {
         plain[plain.len() / 2]
@@ -589,6 +636,7 @@ mod tests {
                 h1_ratio: p.h1_ratio,
                 h1_span: p.h1_span,
                 h1_crossing: p.h1_crossing,
+                h1_stability: p.h1_stability,
             };
             let right = samples
                 .iter()
@@ -619,13 +667,32 @@ mod tests {
                 truth: [1, usize::from(hole)],
             });
         }
-        let land = h1_landscape(&samples, false);
+        let plain = FitOptions::cap(1.0);
+        let land = h1_landscape(&samples, plain);
         assert_eq!(land.len(), h1_ratios().len() * h1_spans().len());
+        let gates = |crossing, stability| Gates {
+            crossing,
+            stability,
+        };
         let with: usize = h1_crossings()
             .into_iter()
-            .map(|c| h1_ratios().len() * column_spans(c).len())
+            .map(|c| h1_ratios().len() * column_spans(gates(c, None)).len())
             .sum();
-        assert_eq!(h1_landscape(&samples, true).len(), with);
+        let crossing = FitOptions {
+            crossing: true,
+            ..plain
+        };
+        assert_eq!(h1_landscape(&samples, crossing).len(), with);
+        let both: usize = h1_crossings()
+            .into_iter()
+            .flat_map(|c| h1_stabilities().into_iter().map(move |s| (c, s)))
+            .map(|(c, s)| h1_ratios().len() * column_spans(gates(c, s)).len())
+            .sum();
+        let all = FitOptions {
+            stability: true,
+            ..crossing
+        };
+        assert_eq!(h1_landscape(&samples, all).len(), both);
         scores_like_the_rule(&samples, &land);
         for cap in [0.0, 0.34, 1.0] {
             let fit = fit(&samples, FitOptions::cap(cap)).unwrap();
@@ -681,13 +748,72 @@ mod tests {
                 truth: [1, usize::from(k % 3 == 0)],
             });
         }
-        let land = h1_landscape(&samples, true);
+        let options = FitOptions {
+            crossing: true,
+            ..FitOptions::cap(1.0)
+        };
+        let land = h1_landscape(&samples, options);
         scores_like_the_rule(&samples, &land);
         let with_test = land.iter().filter(|p| p.h1_crossing.is_some()).count();
+        let gated = Gates {
+            crossing: Some(0.1),
+            stability: None,
+        };
         assert_eq!(
             with_test,
-            24 * h1_ratios().len() * column_spans(Some(0.1)).len()
+            24 * h1_ratios().len() * column_spans(gated).len()
         );
+    }
+
+    /// The same with split stabilities (on both sides of every grid value, some bars
+    /// without one): every point of the stability grid scores what judging each window
+    /// with `Classifier::robust` gives.
+    #[test]
+    fn the_stability_landscape_scores_like_the_rule() {
+        let mut samples = Vec::new();
+        for k in 0..12 {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            let x = |j: usize| Some(0.3 + 0.61 * ((k * 5 + j * 3) % 14) as f64);
+            v.push(Feature {
+                stability: x(0),
+                ..f(1, 1.0, 1.4 + 0.35 * k as f64)
+            });
+            v.push(Feature {
+                stability: x(1),
+                ..f(1, 0.5, 0.9 + 0.02 * k as f64)
+            });
+            v.push(Feature {
+                stability: None,
+                ..f(1, 1.0, 1.5 + 0.05 * k as f64)
+            });
+            if k % 3 == 0 {
+                v.push(Feature {
+                    stability: x(2),
+                    ..f(1, 0.8, 3.0 + 0.5 * k as f64)
+                });
+            }
+            samples.push(Sample {
+                components: vec![v],
+                truth: [1, usize::from(k % 3 == 0)],
+            });
+        }
+        let options = FitOptions {
+            stability: true,
+            ..FitOptions::cap(1.0)
+        };
+        let land = h1_landscape(&samples, options);
+        scores_like_the_rule(&samples, &land);
+        let gated = Gates {
+            crossing: None,
+            stability: Some(1.0),
+        };
+        let with_test = land.iter().filter(|p| p.h1_stability.is_some()).count();
+        assert_eq!(
+            with_test,
+            31 * h1_ratios().len() * column_spans(gated).len()
+        );
+        assert!(land.iter().all(|p| p.h1_crossing.is_none()));
     }
 
     /// A hole-free window holds a noise loop (ratio 5.5) between the two real holes (ratios
@@ -833,6 +959,7 @@ mod tests {
         let options = FitOptions {
             max_false_holes: 0.0,
             crossing: true,
+            stability: false,
         };
         // Not asked for, no crossing test.
         assert_eq!(
@@ -854,6 +981,53 @@ mod tests {
         let plain: Vec<Sample> = (0..8).map(|k| window(&[None], k % 2 == 0)).collect();
         let fit = super::fit(&plain, options).unwrap();
         assert_eq!(fit.classifier.h1_crossing, None);
+        assert_eq!(fit.false_holes, 0.0);
+    }
+
+    /// Real holes and noise loops with the same persistence (ratio 4, a life of 3 σ) but
+    /// stabilities of 6 and 1: only a stability test gets every window right. The fit must
+    /// take one between them; without stabilities it must take none.
+    #[test]
+    fn a_stability_test_is_fitted_only_where_it_separates() {
+        let window = |loops: &[Option<f64>], hole: bool| {
+            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+            v.push(f(0, 0.0, f64::INFINITY));
+            for &stability in loops {
+                v.push(Feature {
+                    stability,
+                    ..f(1, 1.0, 4.0)
+                });
+            }
+            Sample {
+                components: vec![v],
+                truth: [1, usize::from(hole)],
+            }
+        };
+        let mut samples = Vec::new();
+        for _ in 0..4 {
+            samples.push(window(&[Some(6.0)], true));
+            samples.push(window(&[Some(1.0)], false));
+        }
+        let options = FitOptions {
+            stability: true,
+            ..FitOptions::cap(0.0)
+        };
+        assert_eq!(
+            fit(&samples, FitOptions::cap(0.0))
+                .unwrap()
+                .classifier
+                .h1_stability,
+            None
+        );
+        let fit = fit(&samples, options).unwrap();
+        assert_eq!(fit.accuracy, 1.0, "{fit:?}");
+        assert_eq!(fit.classifier.h1_crossing, None);
+        // The stabilities that separate them: 1.25 to 6 (20 grid values); the middle one,
+        // the 11th, is 3.75.
+        assert_eq!(fit.classifier.h1_stability, Some(3.75));
+        let plain: Vec<Sample> = (0..8).map(|k| window(&[None], k % 2 == 0)).collect();
+        let fit = super::fit(&plain, options).unwrap();
+        assert_eq!(fit.classifier.h1_stability, None);
         assert_eq!(fit.false_holes, 0.0);
     }
 }

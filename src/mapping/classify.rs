@@ -42,6 +42,11 @@ pub struct Classifier {
     /// compute no share (`Paper`, the oracle): no such test.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub h1_crossing: Option<f64>,
+    /// … and, when set, its split stability ([`super::stability`]) is at least this: both
+    /// halves of the window's encounters show a loop at its place with a life of this many
+    /// of their σ. Absent in models fitted without it: no such test.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub h1_stability: Option<f64>,
 }
 
 /// The shipped models, one bank per mapping method (`assets/classifier.json`), each model
@@ -373,6 +378,16 @@ impl Models {
                         path.display()
                     );
                 }
+                if let Some(x) = c.h1_stability
+                    && !(x.is_finite() && x >= 0.0)
+                {
+                    anyhow::bail!(
+                        "{}: the {name} model's h1_stability is {x}; it is the least life, in \
+                         σ, that both halves of a window must give a hole, a finite number ≥ 0 \
+                         (or leave it out for no stability test)",
+                        path.display()
+                    );
+                }
                 if let Some(v) = m.leader_speed
                     && !(v.is_finite() && v > 0.0)
                 {
@@ -437,16 +452,19 @@ pub struct Feature {
     pub death: f64,
     /// The crossing share of an H1 bar's void ([`super::crossing`]), where computed.
     pub crossing: Option<f64>,
+    /// The split stability of an H1 bar ([`super::stability`]), where computed.
+    pub stability: Option<f64>,
 }
 
 impl Feature {
-    /// A bar without a crossing share.
+    /// A bar without a crossing share or a stability.
     pub fn bar(dim: usize, birth: f64, death: f64) -> Self {
         Self {
             dim,
             birth,
             death,
             crossing: None,
+            stability: None,
         }
     }
 }
@@ -510,7 +528,10 @@ impl Classifier {
             1 => {
                 let crossed =
                     matches!((self.h1_crossing, f.crossing), (Some(max), Some(x)) if x > max);
+                let unstable =
+                    matches!((self.h1_stability, f.stability), (Some(min), Some(x)) if x < min);
                 !crossed
+                    && !unstable
                     && (f.death.is_finite()
                         && f.birth > 0.0
                         && f.death / f.birth >= self.h1_ratio
@@ -549,6 +570,7 @@ mod tests {
             h1_ratio: 2.0,
             h1_span: 3.0,
             h1_crossing: None,
+            h1_stability: None,
         };
         let diagram = vec![
             f(0, 0.0, 1.0),
@@ -589,6 +611,7 @@ mod tests {
                 h1_ratio,
                 h1_span: 1.0,
                 h1_crossing: None,
+                h1_stability: None,
             },
             fitted_on: format!("ratio {h1_ratio}"),
             events_per_point: density.map(|[min, median, max]| Density { min, median, max }),
@@ -731,6 +754,7 @@ mod tests {
             h1_ratio: 2.0,
             h1_span: 3.0,
             h1_crossing: Some(0.05),
+            h1_stability: None,
         };
         let with = |x: Option<f64>| Feature {
             crossing: x,
@@ -761,6 +785,60 @@ mod tests {
         assert!(c.robust(&with(Some(0.9)), 1.0));
         // Written only when set, so model files without it read and write unchanged.
         assert!(!serde_json::to_string(&c).unwrap().contains("crossing"));
+    }
+
+    /// The stability test keeps an H1 bar only if its stability is at least
+    /// `h1_stability`; a bar without one, or a model without the test, judges by
+    /// persistence alone.
+    #[test]
+    fn the_stability_test_gates_h1_only() {
+        let mut c = Classifier {
+            h0_ratio: 5.0,
+            h1_ratio: 2.0,
+            h1_span: 3.0,
+            h1_crossing: None,
+            h1_stability: Some(2.5),
+        };
+        let with = |x: Option<f64>| Feature {
+            stability: x,
+            ..f(1, 1.0, 5.0)
+        };
+        assert!(c.robust(&with(Some(2.5)), 1.0));
+        assert!(!c.robust(&with(Some(2.4999999)), 1.0));
+        assert!(c.robust(&with(None), 1.0));
+        // Persistence must pass too.
+        assert!(!c.robust(
+            &Feature {
+                stability: Some(9.0),
+                ..f(1, 1.0, 1.9)
+            },
+            1.0
+        ));
+        // H0 ignores it.
+        assert!(c.robust(
+            &Feature {
+                stability: Some(0.0),
+                ..f(0, 0.0, 6.0)
+            },
+            1.0
+        ));
+        // The candidate rule keeps the test.
+        assert_eq!(c.candidate().h1_stability, Some(2.5));
+        c.h1_stability = None;
+        assert!(c.robust(&with(Some(0.0)), 1.0));
+        assert!(!serde_json::to_string(&c).unwrap().contains("stability"));
+    }
+
+    #[test]
+    fn a_stability_below_0_is_refused() {
+        let mut m = Models::shipped();
+        m.embedded.0[0].classifier.h1_stability = Some(-1.0);
+        let err = load_text(&serde_json::to_string(&m).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("h1_stability is -1"), "{err}");
+        m.embedded.0[0].classifier.h1_stability = Some(3.25);
+        assert_eq!(load_text(&serde_json::to_string(&m).unwrap()).unwrap(), m);
     }
 
     #[test]

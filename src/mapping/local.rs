@@ -75,6 +75,10 @@ pub struct LocalParams {
     /// Then place them on their agents' time lines, pinned by the encounters with
     /// landmarks, with this floor τ in seconds ([`super::timelines`]; default: `None`).
     pub timelines: Option<f64>,
+    /// Compute every H1 bar's split stability ([`super::stability`]) with the
+    /// `embedding_rips` stage, even where the window's model has no stability test
+    /// (default: `false`; a model with one always gets them).
+    pub stability: bool,
 }
 
 impl Default for LocalParams {
@@ -93,6 +97,7 @@ impl Default for LocalParams {
             embedding_rips: None,
             bridge: false,
             timelines: None,
+            stability: false,
         }
     }
 }
@@ -124,6 +129,7 @@ impl LocalParams {
             if m.agent_timelines {
                 p.timelines = Some(super::timelines::TIMELINE_FLOOR);
             }
+            p.stability = m.split_stability;
         }
         p
     }
@@ -147,6 +153,10 @@ pub struct MapBar {
     /// segments near its void that pass through it ([`super::crossing`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub crossing: Option<f64>,
+    /// The split stability of an H1 bar with a life of at least
+    /// [`super::stability::STABILITY_FLOOR`] σ, where computed ([`super::stability`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stability: Option<f64>,
 }
 
 /// A robust hole: its bar and a representative cycle as encounters (indices into the
@@ -474,6 +484,28 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 }
             }
         }
+        if let Some(er) = p
+            .embedding_rips
+            .as_ref()
+            .filter(|_| p.stability || classifier.h1_stability.is_some())
+        {
+            let plane = |k: usize| [points[reps[k]][0], points[reps[k]][1]];
+            let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
+            let er = er.for_share(members.len() as f64 / mapped as f64);
+            let halves = super::stability::component_halves(&enc, &members, &coords, &er);
+            for (bar, f) in diagram.bars.iter().zip(features.iter_mut()) {
+                if f.dim != 1
+                    || !f.death.is_finite()
+                    || f.death - f.birth < super::stability::STABILITY_FLOOR * sigma
+                {
+                    continue;
+                }
+                if let Some(t) = bar.death_triangle {
+                    let (centre, r) = super::crossing::void_disc(t.map(plane), f.death);
+                    f.stability = Some(super::stability::stability(&halves, centre, r, sigma));
+                }
+            }
+        }
         let mut betti = [0, 0];
         let mut bars = Vec::new();
         let mut holes = Vec::new();
@@ -522,6 +554,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                     None
                 },
                 crossing: f.crossing,
+                stability: f.stability,
             });
         }
         components.push(Component {
@@ -697,6 +730,60 @@ mod tests {
                 c.events.len()
             );
         }
+    }
+
+    /// Split stabilities are computed only when asked for (`mapping.split_stability`) or
+    /// when the window's model has a stability test, and then for exactly the H1 bars with
+    /// a life of at least `STABILITY_FLOOR` σ; a model's stability test gates robustness.
+    #[test]
+    fn stabilities_are_computed_when_asked_or_judged_by() {
+        let log = synthetic_log(&SyntheticParams::default(), 3000);
+        let (window, mut params) = whole_log_embedded(&log);
+        let stable_bars = |map: &LocalMap| -> Vec<Option<f64>> {
+            map.components
+                .iter()
+                .flat_map(|c| c.diagram.iter().map(|b| b.stability))
+                .collect()
+        };
+        let plain = local_map(&log, &window, &params);
+        assert!(stable_bars(&plain).iter().all(Option::is_none));
+
+        params.stability = true;
+        let asked = local_map(&log, &window, &params);
+        let floor = super::super::stability::STABILITY_FLOOR;
+        let mut with = 0;
+        for c in &asked.components {
+            for b in &c.diagram {
+                let long = b.dim == 1
+                    && b.void.is_some()
+                    && b.death.is_some_and(|d| d - b.birth >= floor * c.scale);
+                assert_eq!(b.stability.is_some(), long, "{b:?}");
+                assert!(b.stability.is_none_or(|x| x.is_finite() && x >= 0.0));
+                with += usize::from(long);
+            }
+        }
+        assert!(with > 0, "some loop is long enough to get a stability");
+        // The stabilities change nothing else.
+        assert_eq!(asked.betti, plain.betti);
+        assert_eq!(asked.points, plain.points);
+
+        // A model with a stability test gets them without being asked, and keeps only the
+        // bars that pass it: none, at a stability no loop reaches.
+        params.stability = false;
+        let mut c = params.classifier.first().classifier;
+        c.h1_ratio = 1.0;
+        c.h1_span = 1.0;
+        params.classifier = Bank::single(c);
+        let loose = local_map(&log, &window, &params);
+        assert!(
+            loose.betti[1] > 0,
+            "a lenient persistence rule keeps some loop"
+        );
+        c.h1_stability = Some(1e6);
+        params.classifier = Bank::single(c);
+        let gated = local_map(&log, &window, &params);
+        assert_eq!(stable_bars(&gated), stable_bars(&asked));
+        assert_eq!(gated.betti[1], 0);
     }
 
     #[test]

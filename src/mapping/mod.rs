@@ -8,6 +8,7 @@ pub mod encounter_graph;
 pub mod local;
 pub mod output;
 pub mod pipeline;
+pub mod stability;
 pub mod stitch;
 pub mod subsample;
 pub mod synthetic;

@@ -732,6 +732,7 @@ mod tests {
                 h1_ratio: 2.3,
                 h1_span: 4.25,
                 h1_crossing: None,
+                h1_stability: None,
             },
             rows: Vec::new(),
         }

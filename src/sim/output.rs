@@ -148,6 +148,9 @@ pub fn world_json(world: &World) -> Value {
     if m.agent_timelines {
         v["mapping"]["agent_timelines"] = json!(true);
     }
+    if m.split_stability {
+        v["mapping"]["split_stability"] = json!(true);
+    }
     if m.rips_points != crate::mapping::dense::EMBEDDED_POINTS {
         v["mapping"]["rips_points"] = json!(m.rips_points);
     }

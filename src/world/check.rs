@@ -635,6 +635,7 @@ impl WorldSpec {
             encounter_midpoints: m.encounter_midpoints.unwrap_or(md.encounter_midpoints),
             rips_points,
             agent_timelines: m.agent_timelines.unwrap_or(md.agent_timelines),
+            split_stability: m.split_stability.unwrap_or(md.split_stability),
         };
 
         let world = World {

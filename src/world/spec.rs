@@ -115,6 +115,7 @@ pub struct MappingSpec {
     pub encounter_midpoints: Option<bool>,
     pub rips_points: Option<i64>,
     pub agent_timelines: Option<bool>,
+    pub split_stability: Option<bool>,
 }
 
 /// Where a spec came from: used to say `file:line:col` in errors.
@@ -277,6 +278,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.encounter_midpoints",
     "mapping.rips_points",
     "mapping.agent_timelines",
+    "mapping.split_stability",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it.
@@ -400,6 +402,7 @@ impl WorldSpec {
                             "encounter_midpoints" => put(&mut s.encounter_midpoints, p, v)?,
                             "rips_points" => put(&mut s.rips_points, p, v)?,
                             "agent_timelines" => put(&mut s.agent_timelines, p, v)?,
+                            "split_stability" => put(&mut s.split_stability, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

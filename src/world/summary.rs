@@ -167,10 +167,15 @@ impl World {
             },
             if m.method == super::MappingMethod::Embedded {
                 format!(
-                    "; {} planar Rips points{}",
+                    "; {} planar Rips points{}{}",
                     m.rips_points,
                     if m.agent_timelines {
                         "; encounters placed on their agents' time lines"
+                    } else {
+                        ""
+                    },
+                    if m.split_stability {
+                        "; split stability of every loop"
                     } else {
                         ""
                     }

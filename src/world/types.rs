@@ -182,6 +182,11 @@ pub struct MappingParams {
     /// lines, pinned by the encounters with landmarks (`mapping::timelines`), after the
     /// bridge between exit landmarks (default: `false`).
     pub agent_timelines: bool,
+    /// The `Embedded` method computes every H1 bar's split stability
+    /// (`mapping::stability`) even when the window's model has no stability test (a model
+    /// with one always gets them; default: `false`). For fitting one: `swarmmap calibrate
+    /// --stability`.
+    pub split_stability: bool,
 }
 
 impl Default for MappingParams {
@@ -198,6 +203,7 @@ impl Default for MappingParams {
             encounter_midpoints: false,
             rips_points: crate::mapping::dense::EMBEDDED_POINTS,
             agent_timelines: false,
+            split_stability: false,
         }
     }
 }
