@@ -241,36 +241,7 @@ fn crossing_adds_the_share_to_the_embedded_grid() {
     let shares: std::collections::BTreeSet<&str> = rows.iter().map(|r| r[3]).collect();
     assert_eq!(shares.len(), 25, "{shares:?}");
     assert!(shares.contains("") && shares.contains("0.01") && shares.contains("0.2"));
-    let m = models(&out);
-    let fit = &m.embedded.for_sweep(TINY_SWEEP).0[0];
-    assert!(fit.fitted_on.contains(" --crossing "), "{}", fit.fitted_on);
-    let c = fit.classifier;
-    let row = rows
-        .iter()
-        .find(|r| {
-            r[1].parse::<f64>().unwrap() == c.h1_ratio
-                && r[2].parse::<f64>().unwrap() == c.h1_span
-                && r[3] == c.h1_crossing.map_or(String::new(), |x| x.to_string())
-        })
-        .expect("the fitted rule is a grid point");
-    // It scores the most within the cap, and it has a crossing test only if no rule without
-    // one scores as much.
-    let right = |r: &Vec<&str>| r[6].parse::<usize>().unwrap();
-    let within: Vec<&Vec<&str>> = rows.iter().filter(|r| r[9] == "true").collect();
-    let best = within.iter().map(|r| right(r)).max().unwrap();
-    assert_eq!(right(row), best);
-    let plain_best = within
-        .iter()
-        .filter(|r| r[3].is_empty())
-        .map(|r| right(r))
-        .max()
-        .unwrap();
-    assert_eq!(c.h1_crossing.is_some(), plain_best < best, "{c:?}");
-    // The written model names the share exactly when it has one.
-    let text = std::fs::read_to_string(&out).unwrap();
-    let entry = &text[text.find("\"Embedded\"").unwrap()..];
-    let entry = &entry[..entry.find("\"Oracle\"").unwrap_or(entry.len())];
-    assert_eq!(entry.contains("h1_crossing"), c.h1_crossing.is_some());
+    gated_fit_is_the_best_rule(&out, &rows, Gate::Crossing);
 }
 
 /// With `--stability` the `Embedded` method's training runs record split stabilities, the
@@ -316,16 +287,39 @@ fn stability_adds_the_split_stability_to_the_embedded_grid() {
             .any(|r| !plain.contains(&score(r))),
         "a stability of at least 8 σ changes no score: were stabilities recorded?"
     );
-    let m = models(&out);
+    gated_fit_is_the_best_rule(&out, &rows, Gate::Stability);
+}
+
+/// A test beyond persistence that `calibrate` may fit, with its landscape column.
+#[derive(Clone, Copy)]
+enum Gate {
+    Crossing,
+    Stability,
+}
+
+/// The `Embedded` model that `calibrate` wrote to `out`, fitted with `gate`, against its
+/// landscape `rows`: its rule is a grid point that scores the most within the cap, it has
+/// the gate only if no rule without one scores as much, the fit says it was asked for, and
+/// the model file names the gate exactly when the rule has one.
+fn gated_fit_is_the_best_rule(out: &std::path::Path, rows: &[Vec<&str>], gate: Gate) {
+    let (column, option, field) = match gate {
+        Gate::Crossing => (3, " --crossing ", "h1_crossing"),
+        Gate::Stability => (4, " --stability ", "h1_stability"),
+    };
+    let m = models(out);
     let fit = &m.embedded.for_sweep(TINY_SWEEP).0[0];
-    assert!(fit.fitted_on.contains(" --stability "), "{}", fit.fitted_on);
+    assert!(fit.fitted_on.contains(option), "{}", fit.fitted_on);
     let c = fit.classifier;
+    let value = match gate {
+        Gate::Crossing => c.h1_crossing,
+        Gate::Stability => c.h1_stability,
+    };
     let row = rows
         .iter()
         .find(|r| {
             r[1].parse::<f64>().unwrap() == c.h1_ratio
                 && r[2].parse::<f64>().unwrap() == c.h1_span
-                && r[4] == c.h1_stability.map_or(String::new(), |x| x.to_string())
+                && r[column] == value.map_or(String::new(), |x| x.to_string())
         })
         .expect("the fitted rule is a grid point");
     let right = |r: &Vec<&str>| r[6].parse::<usize>().unwrap();
@@ -334,15 +328,15 @@ fn stability_adds_the_split_stability_to_the_embedded_grid() {
     assert_eq!(right(row), best);
     let plain_best = within
         .iter()
-        .filter(|r| r[4].is_empty())
+        .filter(|r| r[column].is_empty())
         .map(|r| right(r))
         .max()
         .unwrap();
-    assert_eq!(c.h1_stability.is_some(), plain_best < best, "{c:?}");
-    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(value.is_some(), plain_best < best, "{c:?}");
+    let text = std::fs::read_to_string(out).unwrap();
     let entry = &text[text.find("\"Embedded\"").unwrap()..];
     let entry = &entry[..entry.find("\"Oracle\"").unwrap_or(entry.len())];
-    assert_eq!(entry.contains("h1_stability"), c.h1_stability.is_some());
+    assert_eq!(entry.contains(field), value.is_some());
 }
 
 /// One calibration fits the method's and the oracle's models from the same runs, and each

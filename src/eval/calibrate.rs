@@ -715,39 +715,40 @@ mod tests {
         }
     }
 
-    /// With crossing shares on the bars (lives on both sides of 1 σ, shares on both sides
-    /// of every grid value) every point of the crossing grid scores what judging each
-    /// window with `Classifier::robust` gives.
+    /// Twelve windows whose H1 bars have lives on both sides of 1 σ and a gate value
+    /// `value(window, bar)` (or none) set on each by `gate`; every third window has a hole.
+    fn gated_windows(
+        gate: fn(Feature, Option<f64>) -> Feature,
+        value: impl Fn(usize, usize) -> Option<f64>,
+    ) -> Vec<Sample> {
+        (0..12)
+            .map(|k| {
+                let mut v: Vec<Feature> =
+                    (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+                v.push(f(0, 0.0, f64::INFINITY));
+                v.push(gate(f(1, 1.0, 1.4 + 0.35 * k as f64), value(k, 0)));
+                v.push(gate(f(1, 0.5, 0.9 + 0.02 * k as f64), value(k, 1)));
+                v.push(gate(f(1, 1.0, 1.5 + 0.05 * k as f64), None));
+                if k % 3 == 0 {
+                    v.push(gate(f(1, 0.8, 3.0 + 0.5 * k as f64), value(k, 2)));
+                }
+                Sample {
+                    components: vec![v],
+                    truth: [1, usize::from(k % 3 == 0)],
+                }
+            })
+            .collect()
+    }
+
+    /// With crossing shares on the bars (shares on both sides of every grid value) every
+    /// point of the crossing grid scores what judging each window with
+    /// `Classifier::robust` gives.
     #[test]
     fn the_crossing_landscape_scores_like_the_rule() {
-        let mut samples = Vec::new();
-        for k in 0..12 {
-            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
-            v.push(f(0, 0.0, f64::INFINITY));
-            let x = |j: usize| Some(0.004 + 0.0173 * ((k * 5 + j * 3) % 13) as f64);
-            v.push(Feature {
-                crossing: x(0),
-                ..f(1, 1.0, 1.4 + 0.35 * k as f64)
-            });
-            v.push(Feature {
-                crossing: x(1),
-                ..f(1, 0.5, 0.9 + 0.02 * k as f64)
-            });
-            v.push(Feature {
-                crossing: None,
-                ..f(1, 1.0, 1.5 + 0.05 * k as f64)
-            });
-            if k % 3 == 0 {
-                v.push(Feature {
-                    crossing: x(2),
-                    ..f(1, 0.8, 3.0 + 0.5 * k as f64)
-                });
-            }
-            samples.push(Sample {
-                components: vec![v],
-                truth: [1, usize::from(k % 3 == 0)],
-            });
-        }
+        let samples = gated_windows(
+            |b, crossing| Feature { crossing, ..b },
+            |k, j| Some(0.004 + 0.0173 * ((k * 5 + j * 3) % 13) as f64),
+        );
         let options = FitOptions {
             crossing: true,
             ..FitOptions::cap(1.0)
@@ -770,34 +771,10 @@ mod tests {
     /// with `Classifier::robust` gives.
     #[test]
     fn the_stability_landscape_scores_like_the_rule() {
-        let mut samples = Vec::new();
-        for k in 0..12 {
-            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
-            v.push(f(0, 0.0, f64::INFINITY));
-            let x = |j: usize| Some(0.3 + 0.61 * ((k * 5 + j * 3) % 14) as f64);
-            v.push(Feature {
-                stability: x(0),
-                ..f(1, 1.0, 1.4 + 0.35 * k as f64)
-            });
-            v.push(Feature {
-                stability: x(1),
-                ..f(1, 0.5, 0.9 + 0.02 * k as f64)
-            });
-            v.push(Feature {
-                stability: None,
-                ..f(1, 1.0, 1.5 + 0.05 * k as f64)
-            });
-            if k % 3 == 0 {
-                v.push(Feature {
-                    stability: x(2),
-                    ..f(1, 0.8, 3.0 + 0.5 * k as f64)
-                });
-            }
-            samples.push(Sample {
-                components: vec![v],
-                truth: [1, usize::from(k % 3 == 0)],
-            });
-        }
+        let samples = gated_windows(
+            |b, stability| Feature { stability, ..b },
+            |k, j| Some(0.3 + 0.61 * ((k * 5 + j * 3) % 14) as f64),
+        );
         let options = FitOptions {
             stability: true,
             ..FitOptions::cap(1.0)

@@ -469,30 +469,19 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
     for (members, diagram, reps, vertex_metric, lines) in raw {
         let mut features = super::classify::features(&diagram);
         let sigma = sampling_scale(&features);
-        if let Some(lines) = &lines {
-            let plane = |k: usize| [points[reps[k]][0], points[reps[k]][1]];
-            for (bar, f) in diagram.bars.iter().zip(features.iter_mut()) {
-                if f.dim != 1
-                    || !f.death.is_finite()
-                    || f.death - f.birth < super::crossing::CROSSING_FLOOR * sigma
-                {
-                    continue;
-                }
-                if let Some(t) = bar.death_triangle {
-                    let (centre, r) = super::crossing::void_disc(t.map(plane), f.death);
-                    f.crossing = lines.share(centre, r);
-                }
-            }
-        }
-        if let Some(er) = p
+        // The long H1 bars' crossing shares and, where asked or judged by, their split
+        // stabilities: one floor for both (`STABILITY_FLOOR` is `CROSSING_FLOOR`).
+        let halves = p
             .embedding_rips
             .as_ref()
             .filter(|_| p.stability || classifier.h1_stability.is_some())
-        {
+            .map(|er| {
+                let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
+                let er = er.for_share(members.len() as f64 / mapped as f64);
+                super::stability::component_halves(&enc, &members, &coords, &er)
+            });
+        if lines.is_some() || halves.is_some() {
             let plane = |k: usize| [points[reps[k]][0], points[reps[k]][1]];
-            let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
-            let er = er.for_share(members.len() as f64 / mapped as f64);
-            let halves = super::stability::component_halves(&enc, &members, &coords, &er);
             for (bar, f) in diagram.bars.iter().zip(features.iter_mut()) {
                 if f.dim != 1
                     || !f.death.is_finite()
@@ -502,7 +491,12 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
                 }
                 if let Some(t) = bar.death_triangle {
                     let (centre, r) = super::crossing::void_disc(t.map(plane), f.death);
-                    f.stability = Some(super::stability::stability(&halves, centre, r, sigma));
+                    if let Some(lines) = &lines {
+                        f.crossing = lines.share(centre, r);
+                    }
+                    if let Some(halves) = &halves {
+                        f.stability = Some(super::stability::stability(halves, centre, r, sigma));
+                    }
                 }
             }
         }
