@@ -131,6 +131,23 @@ fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
     assert!(!out.exists(), "nothing is fitted or written");
 }
 
+/// `--stability` needs the stabilities: a run that turns them off is refused, not fitted
+/// with a test that never bites.
+#[test]
+fn stability_without_stabilities_is_an_input_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args(["calibrate", WORLD, "--seeds", "1", "--stability"])
+        .args(["--set", "mapping.split_stability=false", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains("drop `--set mapping.split_stability=false`"));
+    assert!(!out.exists(), "nothing is fitted or written");
+}
+
 #[test]
 fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
     let (_dir, out) = shipped_copy();

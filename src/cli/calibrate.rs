@@ -214,10 +214,24 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             "no training worlds: give world files or add worlds/training/*.ron"
         )));
     }
-    // `--stability` needs the bars' stabilities from the training runs.
+    // `--stability` needs the bars' stabilities from the method's training runs (the
+    // oracle's fit has no stability test).
     let mut set = args.set.clone();
-    if args.stability && !set.iter().any(|s| s.starts_with("mapping.split_stability")) {
-        set.push("mapping.split_stability=true".to_string());
+    if args.stability {
+        match set
+            .iter()
+            .find(|s| s.starts_with("mapping.split_stability"))
+        {
+            Some(s) if s.split_once('=').map(|(_, v)| v.trim()) != Some("true") => {
+                return Err(input(anyhow!(
+                    "--stability fits a stability test, which needs the training runs' \
+                     stabilities; drop `--set {s}`"
+                )));
+            }
+            Some(_) => {}
+            None if !args.oracle => set.push("mapping.split_stability=true".to_string()),
+            None => {}
+        }
     }
     let worlds: Vec<World> = paths
         .iter()

@@ -471,10 +471,15 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         let sigma = sampling_scale(&features);
         // The long H1 bars' crossing shares and, where asked or judged by, their split
         // stabilities: one floor for both (`STABILITY_FLOOR` is `CROSSING_FLOOR`).
+        let floor = super::stability::STABILITY_FLOOR * sigma;
+        let long = |f: &super::classify::Feature| {
+            f.dim == 1 && f.death.is_finite() && f.death - f.birth >= floor
+        };
         let halves = p
             .embedding_rips
             .as_ref()
             .filter(|_| p.stability || classifier.h1_stability.is_some())
+            .filter(|_| features.iter().any(long))
             .map(|er| {
                 let coords: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
                 let er = er.for_share(members.len() as f64 / mapped as f64);
@@ -483,10 +488,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         if lines.is_some() || halves.is_some() {
             let plane = |k: usize| [points[reps[k]][0], points[reps[k]][1]];
             for (bar, f) in diagram.bars.iter().zip(features.iter_mut()) {
-                if f.dim != 1
-                    || !f.death.is_finite()
-                    || f.death - f.birth < super::stability::STABILITY_FLOOR * sigma
-                {
+                if !long(f) {
                     continue;
                 }
                 if let Some(t) = bar.death_triangle {
