@@ -235,20 +235,7 @@ fn the_landscape_lists_the_whole_grid_and_the_fitted_rule_is_its_best_point() {
 /// carries `h1_crossing` exactly when its rule has one.
 #[test]
 fn crossing_adds_the_share_to_the_embedded_grid() {
-    let (dir, out) = shipped_copy();
-    let land = dir.path().join("landscape.csv");
-    let stdout = calibrate(
-        &out,
-        &[
-            "--crossing",
-            "--set",
-            "mapping.method=Embedded",
-            "--landscape",
-            land.to_str().unwrap(),
-        ],
-    );
-    assert!(stdout.contains("h1_crossing"), "{stdout}");
-    let text = std::fs::read_to_string(&land).unwrap();
+    let (_dir, out, text) = gated_landscape(Gate::Crossing);
     let rows: Vec<Vec<&str>> = text
         .lines()
         .skip(1)
@@ -266,20 +253,7 @@ fn crossing_adds_the_share_to_the_embedded_grid() {
 /// the model it writes carries `h1_stability` exactly when its rule has one.
 #[test]
 fn stability_adds_the_split_stability_to_the_embedded_grid() {
-    let (dir, out) = shipped_copy();
-    let land = dir.path().join("landscape.csv");
-    let stdout = calibrate(
-        &out,
-        &[
-            "--stability",
-            "--set",
-            "mapping.method=Embedded",
-            "--landscape",
-            land.to_str().unwrap(),
-        ],
-    );
-    assert!(stdout.contains("h1_stability"), "{stdout}");
-    let text = std::fs::read_to_string(&land).unwrap();
+    let (_dir, out, text) = gated_landscape(Gate::Stability);
     let rows: Vec<Vec<&str>> = text
         .lines()
         .skip(1)
@@ -305,6 +279,31 @@ fn stability_adds_the_split_stability_to_the_embedded_grid() {
         "a stability of at least 8 σ changes no score: were stabilities recorded?"
     );
     gated_fit_is_the_best_rule(&out, &rows, Gate::Stability);
+}
+
+/// An `Embedded` fit of a copy of the shipped models with `gate` asked for: the temporary
+/// directory, the model file and the landscape CSV's text. The fit's printout names the
+/// gate.
+fn gated_landscape(gate: Gate) -> (tempfile::TempDir, std::path::PathBuf, String) {
+    let (option, field) = match gate {
+        Gate::Crossing => ("--crossing", "h1_crossing"),
+        Gate::Stability => ("--stability", "h1_stability"),
+    };
+    let (dir, out) = shipped_copy();
+    let land = dir.path().join("landscape.csv");
+    let stdout = calibrate(
+        &out,
+        &[
+            option,
+            "--set",
+            "mapping.method=Embedded",
+            "--landscape",
+            land.to_str().unwrap(),
+        ],
+    );
+    assert!(stdout.contains(field), "{stdout}");
+    let text = std::fs::read_to_string(&land).unwrap();
+    (dir, out, text)
 }
 
 /// A test beyond persistence that `calibrate` may fit, with its landscape column.

@@ -908,31 +908,37 @@ mod tests {
         assert!(one.unwrap_err().contains("at least two groups"));
     }
 
+    /// Eight windows, every other one with a hole, each holding one loop of death / birth 4
+    /// and a life of 3 σ, its gate value (set by `gate`) `hole` where the window has a hole
+    /// and `noise` where it has none.
+    fn one_loop_windows(
+        gate: fn(Feature, Option<f64>) -> Feature,
+        hole: Option<f64>,
+        noise: Option<f64>,
+    ) -> Vec<Sample> {
+        (0..8)
+            .map(|k| {
+                let with_hole = k % 2 == 0;
+                let mut v: Vec<Feature> =
+                    (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
+                v.push(f(0, 0.0, f64::INFINITY));
+                v.push(gate(f(1, 1.0, 4.0), if with_hole { hole } else { noise }));
+                Sample {
+                    components: vec![v],
+                    truth: [1, usize::from(with_hole)],
+                }
+            })
+            .collect()
+    }
+
     /// Real holes and noise loops with the same persistence (ratio 4, a life of 3 σ) but
     /// crossing shares of 0.01 and 0.3: no (ratio, span) rule gets more than the hole-free
     /// or the holed windows right, a crossing test gets all. The fit must take one between
     /// the two shares; without shares (the same bars, `crossing: None`) it must take none.
     #[test]
     fn a_crossing_test_is_fitted_only_where_it_separates() {
-        let window = |loops: &[Option<f64>], hole: bool| {
-            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
-            v.push(f(0, 0.0, f64::INFINITY));
-            for &crossing in loops {
-                v.push(Feature {
-                    crossing,
-                    ..f(1, 1.0, 4.0)
-                });
-            }
-            Sample {
-                components: vec![v],
-                truth: [1, usize::from(hole)],
-            }
-        };
-        let mut samples = Vec::new();
-        for _ in 0..4 {
-            samples.push(window(&[Some(0.01)], true));
-            samples.push(window(&[Some(0.3)], false));
-        }
+        let gate = |b, crossing| Feature { crossing, ..b };
+        let samples = one_loop_windows(gate, Some(0.01), Some(0.3));
         let options = FitOptions {
             max_false_holes: 0.0,
             crossing: true,
@@ -955,7 +961,7 @@ mod tests {
         assert_eq!(max, 0.07);
         // Without shares no rule separates them; the plain rule that shows no false hole
         // (cap 0) is kept, as before the crossing test existed.
-        let plain: Vec<Sample> = (0..8).map(|k| window(&[None], k % 2 == 0)).collect();
+        let plain = one_loop_windows(gate, None, None);
         let fit = super::fit(&plain, options).unwrap();
         assert_eq!(fit.classifier.h1_crossing, None);
         assert_eq!(fit.false_holes, 0.0);
@@ -966,25 +972,8 @@ mod tests {
     /// take one between them; without stabilities it must take none.
     #[test]
     fn a_stability_test_is_fitted_only_where_it_separates() {
-        let window = |loops: &[Option<f64>], hole: bool| {
-            let mut v: Vec<Feature> = (0..20).map(|i| f(0, 0.0, 1.0 + 0.01 * i as f64)).collect();
-            v.push(f(0, 0.0, f64::INFINITY));
-            for &stability in loops {
-                v.push(Feature {
-                    stability,
-                    ..f(1, 1.0, 4.0)
-                });
-            }
-            Sample {
-                components: vec![v],
-                truth: [1, usize::from(hole)],
-            }
-        };
-        let mut samples = Vec::new();
-        for _ in 0..4 {
-            samples.push(window(&[Some(6.0)], true));
-            samples.push(window(&[Some(1.0)], false));
-        }
+        let gate = |b, stability| Feature { stability, ..b };
+        let samples = one_loop_windows(gate, Some(6.0), Some(1.0));
         let options = FitOptions {
             stability: true,
             ..FitOptions::cap(0.0)
@@ -1002,7 +991,7 @@ mod tests {
         // The stabilities that separate them: 1.25 to 6 (20 grid values); the middle one,
         // the 11th, is 3.75.
         assert_eq!(fit.classifier.h1_stability, Some(3.75));
-        let plain: Vec<Sample> = (0..8).map(|k| window(&[None], k % 2 == 0)).collect();
+        let plain = one_loop_windows(gate, None, None);
         let fit = super::fit(&plain, options).unwrap();
         assert_eq!(fit.classifier.h1_stability, None);
         assert_eq!(fit.false_holes, 0.0);
