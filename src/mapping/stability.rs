@@ -111,7 +111,7 @@ impl HalfLoops {
     }
 
     /// The loops of a diagram whose vertex `k` lies at `plane(k)`.
-    pub fn of_diagram(diagram: &Diagram, plane: impl Fn(usize) -> [f64; 2]) -> Self {
+    fn of_diagram(diagram: &Diagram, plane: impl Fn(usize) -> [f64; 2]) -> Self {
         let features = super::classify::features(diagram);
         let sigma = super::classify::sampling_scale(&features);
         if sigma.is_nan() || sigma <= 0.0 {
