@@ -10,7 +10,7 @@ fn swarmmap() -> Command {
 #[test]
 fn check_prints_a_summary_of_each_scenario() {
     // Scenario 3 sweeps at half the speed and maps with twice the planar Rips points
-    // (README, "Accuracy", step 29).
+    // (docs/accuracy.md, step 29).
     for (file, windows, obstacles, speed, sweep, rips) in [
         (
             "worlds/scenario1.ron",

@@ -101,7 +101,7 @@ fn every_bundled_world_is_valid() {
 }
 
 /// The paper's parameters, except the sensing, swarm size and method that the accuracy
-/// campaign chose (README, "Accuracy", steps 2 and 13): r_d = 10 cm, 30 % landmarks, 200
+/// campaign chose (docs/accuracy.md, steps 2 and 13): r_d = 10 cm, 30 % landmarks, 200
 /// agents, the `Embedded` method with a switch cost of r_d / v = 1 s, c = 35.
 #[test]
 fn the_scenarios_use_the_papers_parameters_but_the_measured_sensing() {
@@ -118,7 +118,7 @@ fn the_scenarios_use_the_papers_parameters_but_the_measured_sensing() {
         assert_eq!(w.mapping.method, swarmmap::world::MappingMethod::Embedded);
         assert_eq!(w.swarm.speed, 0.1);
         // Scenario 3's small obstacles need a slower sweep, and twice the planar Rips
-        // points for its twice as many encounters (README, "Accuracy", step 29).
+        // points for its twice as many encounters (docs/accuracy.md, step 29).
         let (speed, rips) = if name == "scenario3" {
             (0.0025, 4800)
         } else {

@@ -7,7 +7,7 @@
 //! cycle as `i-j;k-l;…` (0-based row numbers of the input, `i < j`), empty for H0 bars, and
 //! a fifth column `void` the three vertices `i;j;k` (`i < j < k`) of the triangle whose
 //! entry kills the class (its longest edge has length `death`; it spans the void itself,
-//! README "Accuracy", step 16), empty for H0 bars and essential classes.
+//! docs/accuracy.md, step 16), empty for H0 bars and essential classes.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

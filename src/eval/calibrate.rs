@@ -13,7 +13,7 @@
 //! separate pieces, that order, not a criterion, picks the piece: on the shipped pipeline's
 //! training windows the best H1 score is reached both by death / birth ≥ 3.4 with any life
 //! up to 3 σ and by a life of ≥ 3.75 σ with any ratio up to 1.5, and the middle of the 19
-//! tied points lies on the first (README, "Accuracy", step 23; `swarmmap calibrate
+//! tied points lies on the first (docs/accuracy.md, step 23; `swarmmap calibrate
 //! --landscape` writes the grid).
 //!
 //! With `--crossing` ([`FitOptions::crossing`]) the H1 grid also runs over a largest crossing
@@ -101,11 +101,11 @@ pub struct FitOptions {
     pub max_false_holes: f64,
     /// Also search a largest crossing share (`h1_crossings`; `calibrate --crossing`).
     /// Off by default: on the training worlds it gains 4 of 450 windows and carries worse
-    /// to unseen ones (README "Accuracy", step 37).
+    /// to unseen ones (docs/accuracy.md, step 37).
     pub crossing: bool,
     /// Also search a least split stability (`h1_stabilities`; `calibrate --stability`).
     /// The training windows' bars need stabilities: map them with
-    /// `mapping.split_stability` (README "Accuracy", step 39).
+    /// `mapping.split_stability` (docs/accuracy.md, step 39).
     pub stability: bool,
 }
 

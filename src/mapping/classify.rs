@@ -15,14 +15,14 @@
 //!   shortly after they are born); the span rejects loops that are long-lived only
 //!   relative to a tiny birth. A model may also carry `h1_crossing`: the largest share of
 //!   the agents' time lines near the loop's void that may pass through it
-//!   ([`super::crossing`]; none in the shipped models, README "Accuracy", step 37).
+//!   ([`super::crossing`]; none in the shipped models, docs/accuracy.md, step 37).
 //!
 //! The three thresholds are fitted by `swarmmap calibrate` on training worlds and shipped as
 //! the default models in `assets/classifier.json`. σ makes them free of the metric's unit
 //! but not of the sampling: each model also records the density it was fitted at (encounters
 //! per vertex of the Rips complexes, [`Density`]), a method may carry several ([`Bank`]),
 //! and each window is judged by the one fitted nearest its own density. The shipped file
-//! holds one model per method (README "Accuracy", step 31, says why).
+//! holds one model per method (docs/accuracy.md, step 31, says why).
 
 use serde::{Deserialize, Serialize};
 
@@ -38,7 +38,7 @@ pub struct Classifier {
     pub h1_span: f64,
     /// … and, when set, its crossing share ([`super::crossing`]) is at most this: few of
     /// the agents' time lines pass through its void. Absent in models fitted without it
-    /// (every model before README "Accuracy", step 37) and in those of methods that
+    /// (every model before docs/accuracy.md, step 37) and in those of methods that
     /// compute no share (`Paper`, the oracle): no such test.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub h1_crossing: Option<f64>,
@@ -102,8 +102,8 @@ impl Model {
 /// (σ), but not in the sampling. With twice the Rips points at the same sweep (2.8–4.2
 /// encounters per point instead of 5.5–8.3), the diagrams hold many more short noise loops,
 /// σ shrinks, and the model fitted at the sparser sampling shows false holes; a model
-/// fitted at the denser sampling asks for a life of 8.75 σ instead of 4.25 σ (README
-/// "Accuracy", step 28). A slower sweep with twice the points lands back at the sparser
+/// fitted at the denser sampling asks for a life of 8.75 σ instead of 4.25 σ
+/// (docs/accuracy.md, step 28). A slower sweep with twice the points lands back at the sparser
 /// density, where the first model serves (step 29). Density is not the whole regime,
 /// though: half-speed windows at 5–6 encounters per vertex are judged badly by the model
 /// fitted at that density at full speed (step 31), so a bank should hold models fitted at
@@ -144,8 +144,8 @@ impl Density {
 /// is one model object, or an array of them, each with its `events_per_point`.
 ///
 /// Why the sweep comes first: a slower sweep keeps the swarm longer round each part of the
-/// arena, and windows of the same density then hold loops of another kind (README
-/// "Accuracy", step 31: half-speed windows at the density of a full-speed model are judged
+/// arena, and windows of the same density then hold loops of another kind
+/// (docs/accuracy.md, step 31: half-speed windows at the density of a full-speed model are judged
 /// badly by it), so density alone cannot tell which model fits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bank(pub Vec<Model>);
@@ -497,7 +497,7 @@ pub fn sampling_scale(features: &[Feature]) -> f64 {
 /// the global map once a neighbouring window sees one at the same place
 /// ([`crate::mapping::stitch`]). Two windows see an obstacle of their overlap at different
 /// times, from different encounters, so their loops are two observations: each may be
-/// weaker than one window's alone must be (README "Accuracy", step 32).
+/// weaker than one window's alone must be (docs/accuracy.md, step 32).
 pub const CANDIDATE_SHARE: [f64; 2] = [0.85, 0.75];
 
 /// The strong test's multiple of `h1_span`: a robust hole that a neighbouring window

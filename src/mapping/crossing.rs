@@ -20,7 +20,7 @@
 //! (ordered by their middles) while it is not a static landmark. A landmark's own
 //! encounters all lie at its place; their segments say nothing about walking.
 //!
-//! Measured (README, "Accuracy", step 37) on scenario 3 (seeds 1–20, bars with a life of
+//! Measured (docs/accuracy.md, step 37) on scenario 3 (seeds 1–20, bars with a life of
 //! at least 2.5 σ): loops round an obstacle have shares of 0–0.045 (median 0.003), loops
 //! that are no obstacle 0.005–0.134 (median 0.049). A strong signal but not a clean cut:
 //! the embedding scatters some small obstacles' encounters across their void. The

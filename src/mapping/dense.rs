@@ -33,8 +33,8 @@ pub const EMBEDDED_POINTS: usize = 1200;
 impl DenseParams {
     /// The `Embedded` method's topology stage: MaxMin of [`EMBEDDED_POINTS`] points on the
     /// plane of the first two coordinates, without density filter (`keep = 1`). Measured on
-    /// the true positions of encounters (README, "Which stage loses the holes"): the filter
-    /// keeps the dense clusters of encounters at static landmarks and drops the moving
+    /// the true positions of encounters (docs/accuracy.md, "Which stage loses the holes"):
+    /// the filter keeps the dense clusters of encounters at static landmarks and drops the moving
     /// agents' encounters between them, which opens false holes in empty arenas; and with
     /// 300 points the sampling scale σ is too coarse for 1–1.5 m obstacles.
     pub fn embedded() -> Self {
@@ -63,7 +63,7 @@ impl DenseParams {
     /// window, so that the classifier's scale-free thresholds mean the same thing in both.
     /// With `m` points in each of the two strips beside scenario 2's bar, a strip was
     /// sampled twice as densely as a whole window (σ 0.77–0.92 against 0.89–1.52, scenario 2 seeds 6, 7, 12), and the
-    /// estimate's ≈ 0.6 m cells stood out as holes (README "Accuracy", step 17).
+    /// estimate's ≈ 0.6 m cells stood out as holes (docs/accuracy.md, step 17).
     pub fn for_share(&self, share: f64) -> Self {
         let scaled = if share.is_finite() && share > 0.0 {
             (self.m as f64 * share.min(1.0)).round() as usize
@@ -181,7 +181,7 @@ pub fn knn_radius(points: &[[f64; 3]], k: usize, dims: usize) -> Vec<f64> {
 /// kept point farthest from every pick so far (ties: the first in index order), until `m`
 /// are picked or every kept point coincides with a pick. Done naively this is `m · n`
 /// distance evaluations (9 · 10⁷ for 4 800 picks of scenario 2's 18 800-encounter window;
-/// 9.4 % of `swarmmap map`'s CPU samples there, README "Accuracy", step 28). Two facts make
+/// 9.4 % of `swarmmap map`'s CPU samples there, docs/accuracy.md, step 28). Two facts make
 /// it local: a pick `j` taken at radius `r`
 /// (the largest nearest-pick distance) can only lower the nearest-pick distance of points
 /// within `r` of it, since every other point is already within `r` of a pick; and `r`

@@ -46,8 +46,8 @@
 //! may switch to the other agent's line for free. Each switch moves the path's position by
 //! up to r_d (the two agents were within r_d, not at one point), so a chain of quick
 //! contacts crosses space at no cost in time: in a dense swarm shortest paths pick chains
-//! whose offsets happen to line up, and the metric falls far below travel time (README,
-//! "Accuracy", step 13: at 200 agents, median metric × v ÷ true distance 0.41–0.58
+//! whose offsets happen to line up, and the metric falls far below travel time
+//! (docs/accuracy.md, step 13: at 200 agents, median metric × v ÷ true distance 0.41–0.58
 //! between landmark sites). With a switch cost σ_s
 //! ([`EncounterGraph::build_switching`]) each encounter becomes two halves, one on each
 //! agent's line, joined by an edge of weight σ_s; the lines and static stars are built on
@@ -70,7 +70,7 @@
 //! approach), and two encounters of one agent weigh |m₁ − m₂|. The sparse argument is
 //! unchanged: sorted by middle, consecutive gaps add up to the clique's weight
 //! (`sparse_equals_clique_with_midpoints`). Static stars still join the encounters whose
-//! intervals meet the static interval. README "Accuracy", step 25, measured the weight on
+//! intervals meet the static interval. docs/accuracy.md, step 25, measured the weight on
 //! landmark sites (least middle-to-middle time between sites under 0.5 m apart: −0.03 m
 //! median error, the interval gap −0.18 m).
 

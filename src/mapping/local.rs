@@ -170,8 +170,8 @@ pub struct Hole {
     pub cycle: Vec<(usize, usize)>,
     /// The three representatives (indices into `events`) of the triangle whose entry
     /// kills the hole's class; its longest edge, of length `death`, spans the void itself,
-    /// which the cycle, drawn through the bar's birth edge, can pass 1–3 m from (README
-    /// "Accuracy", step 16). `null` only if the engine gave no death triangle.
+    /// which the cycle, drawn through the bar's birth edge, can pass 1–3 m from
+    /// (docs/accuracy.md, step 16). `null` only if the engine gave no death triangle.
     pub void: Option<[usize; 3]>,
 }
 
@@ -273,8 +273,8 @@ impl VertexMetric {
 /// dispersion's encounters; nothing static bridges time among them, so the metric cannot
 /// place them: in window 1 of scenario 1 (seeds 1–2) they are 27 % of the events and their
 /// embedded positions err by 1.5–1.6 m (median), against 0.5–0.75 m for later ones, and
-/// the window's rank correlation is 0.56–0.58 with them and 0.94–0.95 without (README
-/// "Accuracy", step 20). Only intervals that begin by the window's end count, so a window
+/// the window's rank correlation is 0.56–0.58 with them and 0.94–0.95 without
+/// (docs/accuracy.md, step 20). Only intervals that begin by the window's end count, so a window
 /// is mapped alike from the whole log and from its prefix up to the window's end
 /// ([`crate::pipeline`], mapping alongside the simulation).
 pub fn first_landmark_start(log: &EncounterLog, window: &Window) -> Option<f64> {

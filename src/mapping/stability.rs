@@ -26,7 +26,7 @@
 //! 0 when a half has no matching loop: the life of the weaker half's best witness, in that
 //! half's own sampling scale σ (the median finite H0 death, [`super::classify`]).
 //!
-//! Measured (README, "Accuracy", step 39). On scenario 3's windows behind the global
+//! Measured (docs/accuracy.md, step 39). On scenario 3's windows behind the global
 //! failures the small obstacles that the life test misses have stabilities of 4.9–6.6 and
 //! those windows' noise loops at most 4.7; but over all 100 windows of seeds 1–20 the
 //! best fixed rule with a stability test gets 78 right and the best without one 79: some

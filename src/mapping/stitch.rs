@@ -39,12 +39,12 @@
 //!   plane; their holes are compared by time instead: the same hole when the central 80 %
 //!   of their cycles' event times (10th to 90th percentile of the start times) overlap,
 //!   since the leader moves monotonically and a cycle's events happened while it passed
-//!   the hole (README, "Accuracy", step 10). Time alone was the rule until step 30: it
+//!   the hole (docs/accuracy.md, step 10). Time alone was the rule until step 30: it
 //!   depends on the sweep speed, and at half speed the cycles of one obstacle seen by
 //!   two windows missed each other by seconds (scenario 3 seed 5), while on the common
 //!   plane every pair that is one obstacle encircles and no pair of two does (step 30).
 //!
-//! # Holes two windows see, and holes one window sees alone (README "Accuracy", step 32)
+//! # Holes two windows see, and holes one window sees alone (docs/accuracy.md, step 32)
 //!
 //! A window alone keeps a loop as a hole only when its persistence passes the classifier
 //! ([`crate::mapping::classify`]). But an obstacle in the overlap of two domains is seen by
@@ -380,7 +380,7 @@ fn same_hole(
 /// this many sampling scales σ of each other (σ of the earlier map's component). Over
 /// scenario 3's seeds 1–20, the voids of one obstacle seen by two windows lie 0.3–15 σ
 /// apart (median 4), those of two obstacles 48 σ or more, and a noise loop's void lies
-/// within 19 σ of another window's loop in only 5 % of pairs (README "Accuracy", step 32).
+/// within 19 σ of another window's loop in only 5 % of pairs (docs/accuracy.md, step 32).
 pub const SAME_VOID: f64 = 12.0;
 
 /// A neighbouring window covers a place of another map's plane when at least this share of

@@ -29,7 +29,7 @@
 //! and, through their other encounters, by every agent they met: an encounter behind a
 //! small obstacle is placed by the agents that went round it on that side.
 //!
-//! Measured (README, "Accuracy", step 36): on scenario 3, seed 7, window 1 the moving
+//! Measured (docs/accuracy.md, step 36): on scenario 3, seed 7, window 1 the moving
 //! encounters' median error falls from 0.34 m (bridged) to 0.31 m, and the missed obstacle's
 //! bar rises from 3.19 σ (noise up to 2.92 σ) to 3.98 σ (noise up to 2.49 σ). Over seeds
 //! 1–20 of scenario 3 the best single H1 rule gets 83 of the 100 windows right on these

@@ -12,7 +12,7 @@
 //! triangle's vertices (the tie-break), so that equal keys are equal triangles. The many
 //! cofacets that share a value (every cofacet `{a, b, k}` whose longest edge is `{a, b}`
 //! has that edge's value) are ordered by the radix bins too; keyed by value alone they
-//! queued in a binary heap that took 38 % of a long reduction's time (README "Accuracy",
+//! queued in a binary heap that took 38 % of a long reduction's time (docs/accuracy.md,
 //! step 35). The key holds the triangle itself, so the column stores 16-byte keys.
 //!
 //! Monotone only up to cancellation: the engine keeps reduction-matrix columns (edges) and

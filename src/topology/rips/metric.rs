@@ -178,7 +178,7 @@ fn sq<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
 /// are copied in row-major cell order, so the cells of one grid row within the box are one
 /// contiguous run, tested in vectorisable blocks like the default scan. The reductions of
 /// long bars push the cofacets of ~10⁵ cocycle edges at every bound raise, most of them at
-/// bounds far below the diameter of the cloud (README "Accuracy", step 35).
+/// bounds far below the diameter of the cloud (docs/accuracy.md, step 35).
 struct Grid<const D: usize> {
     /// Cells per side.
     g: usize,
