@@ -19,7 +19,7 @@
 //! ends (a Brownian bridge). Encounters at distance 0 from a representative (with its
 //! landmark) keep their MDS position.
 //!
-//! Measured on the training worlds (README, "Accuracy"; classifiers fitted without the
+//! Measured on the training worlds (docs/accuracy.md, step 6; classifiers fitted without the
 //! false-hole cap): bridged clouds get 80.9 % of the training windows right against 73.3 %
 //! for landmark-MDS clouds. On synthetic logs it lowers the Procrustes error (test below).
 //! Cost: O(n · (m + k²)) for n encounters and m representatives.

@@ -38,7 +38,7 @@ pub struct Classifier {
     pub h1_span: f64,
     /// … and, when set, its crossing share ([`super::crossing`]) is at most this: few of
     /// the agents' time lines pass through its void. Absent in models fitted without it
-    /// (every model before docs/accuracy.md, step 37) and in those of methods that
+    /// (every model fitted before docs/accuracy.md, step 37) and in those of methods that
     /// compute no share (`Paper`, the oracle): no such test.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub h1_crossing: Option<f64>,

@@ -50,7 +50,7 @@ use std::collections::BTreeMap;
 
 /// `τ`, seconds: the time an agent of the bundled worlds (r_d = 0.1 m, v = 0.1 m/s)
 /// takes to cross its detection radius. On scenario 3 (seed 7, window 1) τ = 0.1, 1, 3
-/// and 10 s give the missed obstacle 3.77, 3.98, 3.64 and 3.13 σ (README step 36).
+/// and 10 s give the missed obstacle 3.77, 3.98, 3.64 and 3.13 σ (docs/accuracy.md, step 36).
 pub const TIMELINE_FLOOR: f64 = 1.0;
 
 /// Residual, relative to the system's scale, at which conjugate gradients stop.
