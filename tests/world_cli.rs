@@ -180,3 +180,62 @@ fn a_closed_stdout_pipe_is_not_a_panic() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
 }
+
+/// The "free for agent centres" share printed by `swarmmap check`, e.g. `97.3`.
+fn free_share(out: &[u8]) -> f64 {
+    let text = String::from_utf8_lossy(out);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("arena"))
+        .expect("an arena line");
+    let after = line
+        .split("free for agent centres: ")
+        .nth(1)
+        .expect("share");
+    after.split(" %").next().unwrap().parse().expect("a number")
+}
+
+#[test]
+fn obstacles_scale_grows_every_obstacle_and_blames_itself_when_they_leave_the_arena() {
+    let share = |args: &[&str]| {
+        let out = swarmmap()
+            .args(["check", "worlds/scenario3.ron"])
+            .args(args)
+            .output()
+            .expect("runs");
+        assert!(out.status.success(), "{args:?}");
+        free_share(&out.stdout)
+    };
+    let (as_is, larger) = (share(&[]), share(&["--set", "obstacles.scale=1.5"]));
+    // Scaled by 1.5 the six obstacles cover 2.25 times their area; the blocked share also
+    // holds the arena's border band (one body radius, unchanged) and each obstacle's
+    // (which grows only 1.5 times), and the printed share is rounded to 0.1 %, so the
+    // blocked share grows by about 2.1 times: more than 1.8.
+    let (blocked, blocked_larger) = (100.0 - as_is, 100.0 - larger);
+    assert!(
+        blocked_larger > 1.8 * blocked,
+        "{blocked} -> {blocked_larger}"
+    );
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario3.ron",
+            "--set",
+            "obstacles.scale=20",
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "(--set obstacles.scale=20): obstacles[",
+        ));
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario3.ron",
+            "--set",
+            "obstacles.scale=-1",
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("must be a finite number > 0"));
+}

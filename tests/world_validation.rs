@@ -751,3 +751,36 @@ fn agent_timelines_defaults_to_false_and_can_be_set() {
         .to_string();
     assert!(err.starts_with("t.ron:1:28: Expected boolean"), "{err}");
 }
+
+#[test]
+fn errors_of_scaled_obstacles_name_the_scale_unless_a_later_override_replaced_them() {
+    // Scaled 10 times, BASE's 12 m bar leaves the 30 m arena: blamed on the scale.
+    let msg = error_with("obstacles.scale", "10");
+    assert!(
+        msg.starts_with("t.ron (--set obstacles.scale=10): obstacles[0] sticks out of the arena"),
+        "{msg}"
+    );
+    // A later override of one obstacle answers for that obstacle.
+    let mut spec = parse_str(BASE, "t.ron").expect("base parses");
+    apply_override(&mut spec, "obstacles.scale", "1.5").expect("applies");
+    apply_override(
+        &mut spec,
+        "obstacles[1]",
+        "Circle(center: (5.0, 3.0), radius: -1.0)",
+    )
+    .expect("applies");
+    let msg = spec.check().expect_err("a negative radius").to_string();
+    assert!(
+        msg.starts_with("t.ron (--set obstacles[1]=Circle(center: (5.0, 3.0), radius: -1.0)): obstacles[1].radius"),
+        "{msg}"
+    );
+    // A valid scaling checks like a written world with the scaled numbers.
+    let w = valid_with("obstacles.scale", "0.5");
+    assert_eq!(
+        w.obstacles[1],
+        Obstacle::Circle {
+            center: (5.0, 3.0),
+            radius: 0.4
+        }
+    );
+}

@@ -38,6 +38,12 @@ impl Ctx<'_> {
             self.origin.name.as_str()
         };
         let by_override = self.origin.overrides.iter().rev().find(|(p, _)| {
+            // `obstacles.scale` rewrites every obstacle, so it answers for all of them.
+            let p = if p == "obstacles.scale" {
+                "obstacles"
+            } else {
+                p
+            };
             field == p || field.starts_with(&format!("{p}.")) || field.starts_with(&format!("{p}["))
         });
         let location = if let Some((p, v)) = by_override {

@@ -56,6 +56,38 @@ pub fn polygon_area(poly: &[Vec2]) -> f64 {
         / 2.0
 }
 
+/// The area centroid of a simple polygon, in either orientation (shoelace formula, summed
+/// relative to the first vertex so that a polygon far from the origin keeps its precision).
+/// A polygon without area (fewer than three points, or all on one line within a relative
+/// 1e-12 of its extent squared) gives the mean of its vertices; an empty list `(0, 0)`.
+pub fn polygon_centroid(poly: &[Vec2]) -> Vec2 {
+    let n = poly.len();
+    if n == 0 {
+        return (0.0, 0.0);
+    }
+    let o = poly[0];
+    let (mut twice_area, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        let (p, q) = (sub(poly[i], o), sub(poly[(i + 1) % n], o));
+        let cross = p.0 * q.1 - q.0 * p.1;
+        twice_area += cross;
+        cx += (p.0 + q.0) * cross;
+        cy += (p.1 + q.1) * cross;
+    }
+    let extent = poly.iter().fold(0.0f64, |m, p| {
+        m.max((p.0 - o.0).abs()).max((p.1 - o.1).abs())
+    });
+    if twice_area.abs() > 1e-12 * extent * extent && twice_area.is_finite() {
+        (o.0 + cx / (3.0 * twice_area), o.1 + cy / (3.0 * twice_area))
+    } else {
+        let k = n as f64;
+        (
+            poly.iter().map(|p| p.0).sum::<f64>() / k,
+            poly.iter().map(|p| p.1).sum::<f64>() / k,
+        )
+    }
+}
+
 /// Orientation of `c` relative to the directed line `a → b`: `1` left, `-1` right, `0`
 /// collinear (within a tolerance relative to the coordinates' magnitude).
 fn orientation(a: Vec2, b: Vec2, c: Vec2) -> i8 {
@@ -215,6 +247,23 @@ impl World {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn polygon_centroids_match_closed_forms_and_survive_degenerate_input() {
+        let near = |a: Vec2, b: Vec2, tol: f64| (a.0 - b.0).abs() < tol && (a.1 - b.1).abs() < tol;
+        // A triangle's centroid is the mean of its vertices.
+        let tri = [(0.0, 0.0), (3.0, 0.0), (0.0, 6.0)];
+        assert!(near(polygon_centroid(&tri), (1.0, 2.0), 1e-12));
+        // The same square far from the origin keeps its centre to a few ulp of 1e6.
+        let sq = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let far: Vec<Vec2> = sq.iter().map(|p| (p.0 + 1e6, p.1 - 1e6)).collect();
+        assert!(near(polygon_centroid(&far), (1e6 + 0.5, -1e6 + 0.5), 1e-9));
+        // No area: the vertex mean; nothing: the origin.
+        let line = [(0.0, 0.0), (1.0, 1.0), (3.0, 3.0)];
+        assert!(near(polygon_centroid(&line), (4.0 / 3.0, 4.0 / 3.0), 1e-12));
+        assert_eq!(polygon_centroid(&[(2.0, 4.0)]), (2.0, 4.0));
+        assert_eq!(polygon_centroid(&[]), (0.0, 0.0));
+    }
 
     #[test]
     fn distances_are_exact() {

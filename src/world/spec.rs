@@ -41,6 +41,44 @@ pub enum ObstacleSpec {
     },
 }
 
+impl ObstacleSpec {
+    /// Scales the obstacle by `f` about its own centre, keeping its shape and place: a
+    /// circle's radius, a rectangle about its centre, a polygon about its area centroid (the
+    /// mean of its vertices when its area is zero), a wall's length about its midpoint and
+    /// its thickness. Used by `--set obstacles.scale=F`, to ask how small an obstacle a
+    /// world's maps still resolve (docs/accuracy.md, step 41). Values are not checked here:
+    /// the scaled world is validated like a written one.
+    pub fn scale_about_centre(&mut self, f: f64) {
+        let about = |p: &mut Vec2, c: Vec2| {
+            *p = (c.0 + (p.0 - c.0) * f, c.1 + (p.1 - c.1) * f);
+        };
+        match self {
+            Self::Circle { radius, .. } => *radius *= f,
+            Self::Rect { min, max } => {
+                let c = (0.5 * (min.0 + max.0), 0.5 * (min.1 + max.1));
+                about(min, c);
+                about(max, c);
+            }
+            Self::Polygon { points } => {
+                let c = super::geometry::polygon_centroid(points);
+                for p in points.iter_mut() {
+                    about(p, c);
+                }
+            }
+            Self::Wall {
+                from,
+                to,
+                thickness,
+            } => {
+                let c = (0.5 * (from.0 + to.0), 0.5 * (from.1 + to.1));
+                about(from, c);
+                about(to, c);
+                *thickness *= f;
+            }
+        }
+    }
+}
+
 /// `placement: Disk(radius: 1.0)` or `placement: Window`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -243,6 +281,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "arena.width",
     "arena.height",
     "obstacles",
+    "obstacles.scale",
     "swarm",
     "swarm.agents",
     "swarm.speed",
@@ -321,6 +360,24 @@ impl WorldSpec {
             "arena.width" => put(&mut self.arena.get_or_insert_default().width, p, v)?,
             "arena.height" => put(&mut self.arena.get_or_insert_default().height, p, v)?,
             "obstacles" => put(&mut self.obstacles, p, v)?,
+            "obstacles.scale" => {
+                let mut factor: Option<f64> = None;
+                put(&mut factor, p, v)?;
+                match factor.filter(|f| f.is_finite() && *f > 0.0) {
+                    Some(f) => {
+                        for o in self.obstacles.iter_mut().flatten() {
+                            o.scale_about_centre(f);
+                        }
+                    }
+                    None => {
+                        return Err(WorldError::BadSetting {
+                            path: path.to_string(),
+                            value: value.to_string(),
+                            message: "the factor must be a finite number > 0, e.g. `1.25` (a quarter larger) or `0.5` (half the size)".into(),
+                        });
+                    }
+                }
+            }
             "swarm" => put(&mut self.swarm, p, v)?,
             "leader" => put(&mut self.leader, p, v)?,
             "simulation" => put(&mut self.simulation, p, v)?,
@@ -469,5 +526,123 @@ mod tests {
                 other => panic!("{path}: {other:?}"),
             }
         }
+    }
+
+    fn near(a: Vec2, b: Vec2) -> bool {
+        (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12
+    }
+
+    #[test]
+    fn obstacles_scale_about_their_own_centres() {
+        let mut spec = parse_str(
+            "(obstacles: [Circle(center: (2.5, 7.0), radius: 0.4), \
+             Rect(min: (5.9, 2.6), max: (6.7, 3.4)), \
+             Polygon(points: [(0.0, 0.0), (3.0, 0.0), (0.0, 3.0)]), \
+             Wall(from: (1.0, 1.0), to: (5.0, 1.0), thickness: 0.2)])",
+            "t.ron",
+        )
+        .unwrap();
+        spec.set("obstacles.scale", "1.5").unwrap();
+        let o = spec.obstacles.as_ref().unwrap();
+        match &o[0] {
+            ObstacleSpec::Circle { center, radius } => {
+                assert_eq!(*center, (2.5, 7.0));
+                assert!((radius - 0.6).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        match &o[1] {
+            ObstacleSpec::Rect { min, max } => {
+                assert!(
+                    near(*min, (5.7, 2.4)) && near(*max, (6.9, 3.6)),
+                    "{min:?} {max:?}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // The triangle's centroid (1, 1) stays; each vertex moves 1.5 times as far from it.
+        match &o[2] {
+            ObstacleSpec::Polygon { points } => {
+                let want = [(-0.5, -0.5), (4.0, -0.5), (-0.5, 4.0)];
+                assert_eq!(points.len(), want.len());
+                for (p, w) in points.iter().zip(want) {
+                    assert!(near(*p, w), "{points:?}");
+                }
+            }
+            other => panic!("{other:?}"),
+        }
+        match &o[3] {
+            ObstacleSpec::Wall {
+                from,
+                to,
+                thickness,
+            } => {
+                assert!(near(*from, (0.0, 1.0)) && near(*to, (6.0, 1.0)));
+                assert!((thickness - 0.3).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(
+            spec.origin.overrides,
+            vec![("obstacles.scale".to_string(), "1.5".to_string())]
+        );
+    }
+
+    #[test]
+    fn a_polygon_keeps_its_area_centroid_and_scales_its_area() {
+        use super::super::geometry::{polygon_area, polygon_centroid};
+        // An L of two rectangles, [0,3]×[0,1] and [0,1]×[1,3]: area 5, centroid
+        // ((3·1.5 + 2·0.5) / 5, (3·0.5 + 2·2) / 5) = (1.1, 1.1) by decomposition; the same
+        // in either orientation.
+        let l = vec![
+            (0.0, 0.0),
+            (3.0, 0.0),
+            (3.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 3.0),
+            (0.0, 3.0),
+        ];
+        let mut clockwise = l.clone();
+        clockwise.reverse();
+        for poly in [l, clockwise] {
+            assert!(near(polygon_centroid(&poly), (1.1, 1.1)), "{poly:?}");
+            let mut o = ObstacleSpec::Polygon {
+                points: poly.clone(),
+            };
+            o.scale_about_centre(0.5);
+            let ObstacleSpec::Polygon { points } = o else {
+                unreachable!()
+            };
+            assert!((polygon_area(&points).abs() - 5.0 * 0.25).abs() < 1e-12);
+            assert!(near(polygon_centroid(&points), (1.1, 1.1)));
+        }
+    }
+
+    #[test]
+    fn a_bad_scale_is_refused_and_changes_nothing() {
+        let text = "(obstacles: [Circle(center: (2.0, 2.0), radius: 0.5)])";
+        for (bad, why) in [
+            ("0", "must be a finite number > 0"),
+            ("-1.5", "must be a finite number > 0"),
+            ("inf", "must be a finite number > 0"),
+            ("NaN", "must be a finite number > 0"),
+            ("big", "does not parse"),
+            ("\"1.5\"", "does not parse"),
+        ] {
+            let mut spec = parse_str(text, "t.ron").unwrap();
+            let before = spec.obstacles.clone();
+            match spec.set("obstacles.scale", bad) {
+                Err(WorldError::BadSetting { message, .. }) => {
+                    assert!(message.contains(why), "{bad}: {message}");
+                }
+                other => panic!("{bad}: {other:?}"),
+            }
+            assert_eq!(spec.obstacles, before, "{bad}");
+            assert!(spec.origin.overrides.is_empty(), "{bad}");
+        }
+        // A world without obstacles scales to itself.
+        let mut empty = WorldSpec::default();
+        empty.set("obstacles.scale", "2").unwrap();
+        assert_eq!(empty.obstacles, None);
     }
 }
