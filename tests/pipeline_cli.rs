@@ -303,9 +303,21 @@ fn eval_writes_one_row_per_run_and_resumes() {
         .arg(&out)
         .assert()
         .success()
-        .stdout(contains("tiny"));
+        .stdout(contains("tiny"))
+        .stdout(contains("with 95 % Wilson intervals"));
     let csv = fs::read_to_string(out.join("eval.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
+    // One summary row for the one (world, params) group, with the global figure's interval.
+    let summary = fs::read_to_string(out.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 2, "{summary}");
+    assert!(
+        summary.starts_with("world,params,runs,failed,"),
+        "{summary}"
+    );
+    assert!(
+        summary.lines().nth(1).unwrap().starts_with("tiny,,2,0,"),
+        "{summary}"
+    );
     let stored: Vec<_> = fs::read_dir(out.join("runs")).unwrap().collect();
     assert_eq!(stored.len(), 2);
     // A rerun finds both runs done and writes the same rows.

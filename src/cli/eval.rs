@@ -6,7 +6,7 @@ use anyhow::{Context, anyhow};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Mutex;
-use swarmmap::eval::campaign::{Job, combinations, csv, run_campaign, table};
+use swarmmap::eval::campaign::{Job, combinations, csv, groups, run_campaign, summary_csv, table};
 use swarmmap::io::write_atomic;
 use swarmmap::world::WorldSpec;
 
@@ -26,8 +26,9 @@ pub struct EvalArgs {
     /// (repeatable; every combination is run).
     #[arg(long = "set", value_name = "PATH=V1[,V2...]")]
     pub set: Vec<String>,
-    /// Campaign directory: `runs/` (one file per finished run, reused on rerun) and
-    /// `eval.csv` (default: `runs/eval`).
+    /// Campaign directory: `runs/` (one file per finished run, reused on rerun), `eval.csv`
+    /// (one row per run) and `summary.csv` (one row per world and parameters) (default:
+    /// `runs/eval`).
     #[arg(long, default_value = "runs/eval")]
     pub out: PathBuf,
     /// No progress bar.
@@ -118,8 +119,15 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     let csv_path = args.out.join("eval.csv");
     write_atomic(&csv_path, csv(&records).as_bytes())
         .with_context(|| format!("writing {}", csv_path.display()))?;
+    let summary_path = args.out.join("summary.csv");
+    write_atomic(&summary_path, summary_csv(&groups(&records)).as_bytes())
+        .with_context(|| format!("writing {}", summary_path.display()))?;
     print!("{}", table(&records));
-    println!("per-run rows: {}", csv_path.display());
+    println!(
+        "per-run rows: {}; per world and parameters: {}",
+        csv_path.display(),
+        summary_path.display()
+    );
     Ok(())
 }
 

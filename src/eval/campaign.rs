@@ -357,60 +357,104 @@ fn quote(s: &str) -> String {
     }
 }
 
-/// The accuracy table: one line per (world, params), aggregated over seeds.
-pub fn table(records: &[RunRecord]) -> String {
-    let mut groups: BTreeMap<(String, String), Vec<&RunRecord>> = BTreeMap::new();
+/// A (world, params) group of a campaign, aggregated over its seeds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Group {
+    pub world: String,
+    pub params: String,
+    /// Runs, and how many of them failed (no summary).
+    pub runs: usize,
+    pub failed: usize,
+    /// The counts of [`Score`], summed over the group's runs.
+    pub sum: Score,
+    /// Runs with a global truth, and how many of them got the global (β0, β1) right.
+    pub global_runs: usize,
+    pub global_ok: usize,
+    /// Runs with a global hole check, and how many of them passed it.
+    pub global_holes_runs: usize,
+    pub global_holes_ok: usize,
+    /// Per seed: whether its global map was right (runs with a global truth only).
+    pub global_by_seed: BTreeMap<u64, bool>,
+    pub seconds: Vec<f64>,
+}
+
+/// Groups the records by (world, params), in that order.
+pub fn groups(records: &[RunRecord]) -> Vec<Group> {
+    let mut by: BTreeMap<(String, String), Group> = BTreeMap::new();
     for r in records {
-        groups
+        let g = by
             .entry((r.world.clone(), r.params.clone()))
-            .or_default()
-            .push(r);
+            .or_insert_with(|| Group {
+                world: r.world.clone(),
+                params: r.params.clone(),
+                ..Group::default()
+            });
+        g.runs += 1;
+        let Some(summary) = r.summary.as_ref() else {
+            g.failed += 1;
+            continue;
+        };
+        let s = score(summary);
+        let t = &mut g.sum;
+        t.windows += s.windows;
+        t.windows_ok += s.windows_ok;
+        t.b0_ok += s.b0_ok;
+        t.b1_ok += s.b1_ok;
+        t.holeless += s.holeless;
+        t.holeless_ok += s.holeless_ok;
+        t.oracle += s.oracle;
+        t.oracle_ok += s.oracle_ok;
+        t.hole_checks += s.hole_checks;
+        t.holes_ok += s.holes_ok;
+        t.connections += s.connections;
+        t.connections_ok += s.connections_ok;
+        t.spearman.extend_from_slice(&s.spearman);
+        t.procrustes.extend_from_slice(&s.procrustes);
+        if !s.global_truth.is_empty() {
+            g.global_runs += 1;
+            g.global_ok += usize::from(s.global_ok);
+            g.global_by_seed.insert(r.seed, s.global_ok);
+        }
+        if let Some(ok) = s.global_holes_ok {
+            g.global_holes_runs += 1;
+            g.global_holes_ok += usize::from(ok);
+        }
+        g.seconds.push(s.time);
     }
+    by.into_values().collect()
+}
+
+/// The accuracy table: one line per (world, params), aggregated over seeds, then each
+/// group's global figure with its 95 % Wilson interval and, for a world run with several
+/// parameter sets, their paired comparisons ([`confidence`]).
+pub fn table(records: &[RunRecord]) -> String {
+    let groups = groups(records);
     let mut out = String::from(
         "world        params                          runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  glob. holes  spearman  procr.  s/run\n",
     );
-    let pct = |a: usize, b: usize| {
-        if b == 0 {
-            "    -".to_string()
-        } else {
-            format!("{:>5.1}%", 100.0 * a as f64 / b as f64)
-        }
-    };
-    for ((world, params), rs) in &groups {
-        let fails = rs.iter().filter(|r| r.summary.is_none()).count();
-        let scores: Vec<Score> = rs
-            .iter()
-            .filter_map(|r| r.summary.as_ref())
-            .map(score)
-            .collect();
-        let sum = |f: fn(&Score) -> usize| scores.iter().map(f).sum::<usize>();
-        let (w, wok) = (sum(|s| s.windows), sum(|s| s.windows_ok));
-        let sp: Vec<f64> = scores.iter().flat_map(|s| s.spearman.clone()).collect();
-        let pr: Vec<f64> = scores.iter().flat_map(|s| s.procrustes.clone()).collect();
-        let times: Vec<f64> = scores.iter().map(|s| s.time).collect();
+    for g in &groups {
+        let s = &g.sum;
         out.push_str(&format!(
             "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8.2}  {:>6.3}  {:>5.1}\n",
-            world,
-            if params.is_empty() { "(defaults)" } else { params },
-            rs.len(),
-            fails,
-            pct(wok, w),
-            pct(sum(|s| s.b0_ok), w),
-            pct(sum(|s| s.b1_ok), w),
-            pct(sum(|s| s.holes_ok), sum(|s| s.hole_checks)),
-            pct(sum(|s| s.holeless_ok), sum(|s| s.holeless)),
-            pct(sum(|s| s.oracle_ok), sum(|s| s.oracle)),
-            pct(sum(|s| s.connections_ok), sum(|s| s.connections)),
-            pct(scores.iter().filter(|s| s.global_ok).count(), scores.len()),
-            pct(
-                scores.iter().filter(|s| s.global_holes_ok == Some(true)).count(),
-                scores.iter().filter(|s| s.global_holes_ok.is_some()).count(),
-            ),
-            mean(&sp),
-            mean(&pr),
-            mean(&times),
+            g.world,
+            if g.params.is_empty() { "(defaults)" } else { &g.params },
+            g.runs,
+            g.failed,
+            pct(s.windows_ok, s.windows),
+            pct(s.b0_ok, s.windows),
+            pct(s.b1_ok, s.windows),
+            pct(s.holes_ok, s.hole_checks),
+            pct(s.holeless_ok, s.holeless),
+            pct(s.oracle_ok, s.oracle),
+            pct(s.connections_ok, s.connections),
+            pct(g.global_ok, g.global_runs),
+            pct(g.global_holes_ok, g.global_holes_runs),
+            mean(&s.spearman),
+            mean(&s.procrustes),
+            mean(&g.seconds),
         ));
     }
+    out.push_str(&confidence(&groups));
     for r in records.iter().filter(|r| r.error.is_some()) {
         out.push_str(&format!(
             "failed: {} [{}] seed {}: {}\n",
@@ -418,6 +462,144 @@ pub fn table(records: &[RunRecord]) -> String {
             r.params,
             r.seed,
             r.error.as_deref().unwrap_or("")
+        ));
+    }
+    out
+}
+
+fn pct(a: usize, b: usize) -> String {
+    if b == 0 {
+        "    -".to_string()
+    } else {
+        format!("{:>5.1}%", 100.0 * a as f64 / b as f64)
+    }
+}
+
+fn params_label(params: &str) -> &str {
+    if params.is_empty() {
+        "(defaults)"
+    } else {
+        params
+    }
+}
+
+/// Pairs compared per world at most; past that, each group is compared with the first.
+const MAX_PAIRS: usize = 15;
+
+/// How sure the global figures are ([`crate::eval::stats`]): each group's global (β0, β1)
+/// right in k of n runs with its 95 % Wilson interval, and, for every world run with
+/// several parameter sets, each pair of them compared on the seeds both ran (the seeds
+/// right under one only, and the exact McNemar p-value). Empty when no run has a global
+/// truth. Window shares get no interval: one run's windows are not independent draws.
+pub fn confidence(groups: &[Group]) -> String {
+    use crate::eval::stats::{Z95, mcnemar_exact, wilson};
+    let mut out = String::new();
+    let with_truth: Vec<&Group> = groups.iter().filter(|g| g.global_runs > 0).collect();
+    if with_truth.is_empty() {
+        return out;
+    }
+    out.push_str("global ok over independent runs, with 95 % Wilson intervals:\n");
+    for g in &with_truth {
+        let (lo, hi) = wilson(g.global_ok, g.global_runs, Z95).unwrap_or((0.0, 1.0));
+        out.push_str(&format!(
+            "  {:<12} {:<31} {:>4} of {:<4} {:>6}  [{:.1} %, {:.1} %]\n",
+            g.world,
+            params_label(&g.params),
+            g.global_ok,
+            g.global_runs,
+            pct(g.global_ok, g.global_runs),
+            100.0 * lo,
+            100.0 * hi
+        ));
+    }
+    let mut by_world: BTreeMap<&str, Vec<&Group>> = BTreeMap::new();
+    for g in &with_truth {
+        by_world.entry(g.world.as_str()).or_default().push(g);
+    }
+    let mut pairs = Vec::new();
+    for gs in by_world.values().filter(|gs| gs.len() > 1) {
+        let all = gs.len() * (gs.len() - 1) / 2 <= MAX_PAIRS;
+        for i in 0..gs.len() {
+            for j in i + 1..gs.len() {
+                if all || i == 0 {
+                    pairs.push((gs[i], gs[j]));
+                }
+            }
+        }
+    }
+    if pairs.is_empty() {
+        return out;
+    }
+    out.push_str(
+        "global ok, paired by seed (seeds right under one setting only; exact McNemar test):\n",
+    );
+    for (a, b) in pairs {
+        let (mut common, mut only_a, mut only_b) = (0, 0, 0);
+        for (seed, ok_a) in &a.global_by_seed {
+            if let Some(ok_b) = b.global_by_seed.get(seed) {
+                common += 1;
+                only_a += usize::from(*ok_a && !ok_b);
+                only_b += usize::from(*ok_b && !ok_a);
+            }
+        }
+        if common == 0 {
+            continue;
+        }
+        out.push_str(&format!(
+            "  {:<12} {} vs {}: {common} common seeds, {only_a} right only with the first, {only_b} only with the second, p = {:.3}\n",
+            a.world,
+            params_label(&a.params),
+            params_label(&b.params),
+            mcnemar_exact(only_a, only_b)
+        ));
+    }
+    out
+}
+
+/// `summary.csv`: one row per (world, params), the counts behind the table and the global
+/// figure's 95 % Wilson interval (`global_low`, `global_high`, shares from 0 to 1; empty
+/// without a run with a global truth).
+pub fn summary_csv(groups: &[Group]) -> String {
+    use crate::eval::stats::{Z95, wilson};
+    let mut out = String::from(
+        "world,params,runs,failed,windows,windows_ok,b0_ok,b1_ok,hole_checks,holes_ok,\
+         holeless,holeless_ok,oracle,oracle_ok,connections,connections_ok,global_runs,\
+         global_ok,global_low,global_high,global_holes_runs,global_holes_ok,spearman,\
+         procrustes,seconds\n",
+    );
+    for g in groups {
+        let s = &g.sum;
+        let (lo, hi) = wilson(g.global_ok, g.global_runs, Z95)
+            .map_or((String::new(), String::new()), |(l, h)| {
+                (format!("{l:.4}"), format!("{h:.4}"))
+            });
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3}\n",
+            g.world,
+            quote(&g.params),
+            g.runs,
+            g.failed,
+            s.windows,
+            s.windows_ok,
+            s.b0_ok,
+            s.b1_ok,
+            s.hole_checks,
+            s.holes_ok,
+            s.holeless,
+            s.holeless_ok,
+            s.oracle,
+            s.oracle_ok,
+            s.connections,
+            s.connections_ok,
+            g.global_runs,
+            g.global_ok,
+            lo,
+            hi,
+            g.global_holes_runs,
+            g.global_holes_ok,
+            mean(&s.spearman),
+            mean(&s.procrustes),
+            mean(&g.seconds),
         ));
     }
     out
@@ -439,6 +621,93 @@ mod tests {
             vec![("a".into(), "2".into()), ("b".into(), "x".into())]
         );
         assert_eq!(combinations(&[]), vec![Vec::new()]);
+    }
+
+    /// A stored run of `world` with `params` and `seed` whose global map is right or not.
+    fn record(world: &str, params: &str, seed: u64, right: bool) -> RunRecord {
+        let b1 = if right { 2 } else { 1 };
+        RunRecord {
+            world: world.into(),
+            world_file: format!("{world}.ron"),
+            params: params.into(),
+            seed,
+            summary: Some(serde_json::json!({
+                "windows": [{"betti": [1, b1], "truth": [1, 2]}],
+                "connections": [],
+                "global": {"betti": [1, b1], "truth": [1, 2]},
+                "timings": {"a": 2.0}
+            })),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn groups_give_intervals_and_paired_comparisons() {
+        // Setting `s=1`: seeds 1-15 right of 20. Setting `s=2`: all 20 right. Seed 21 of
+        // `s=2` failed outright; `other` has one setting, so no comparison of its own.
+        let mut rs = Vec::new();
+        for seed in 1..=20 {
+            rs.push(record("w", "s=1", seed, seed <= 15));
+            rs.push(record("w", "s=2", seed, true));
+        }
+        rs.push(RunRecord {
+            summary: None,
+            error: Some("boom".into()),
+            ..record("w", "s=2", 21, true)
+        });
+        rs.push(record("other", "", 1, false));
+        let gs = groups(&rs);
+        assert_eq!(gs.len(), 3);
+        let (o, a, b) = (&gs[0], &gs[1], &gs[2]);
+        assert_eq!(
+            (o.world.as_str(), o.global_ok, o.global_runs),
+            ("other", 0, 1)
+        );
+        assert_eq!((a.params.as_str(), a.runs, a.failed), ("s=1", 20, 0));
+        assert_eq!((a.global_ok, a.global_runs, a.sum.windows_ok), (15, 20, 15));
+        assert_eq!(
+            (b.runs, b.failed, b.global_ok, b.global_runs),
+            (21, 1, 20, 20)
+        );
+        let text = confidence(&gs);
+        // 15 of 20: statsmodels' Wilson interval [0.5313, 0.8881].
+        assert!(
+            text.contains("15 of 20    75.0%  [53.1 %, 88.8 %]"),
+            "{text}"
+        );
+        assert!(
+            text.contains("20 of 20   100.0%  [83.9 %, 100.0 %]"),
+            "{text}"
+        );
+        // Five seeds right only with the second setting: p = 2 / 2^5.
+        assert!(
+            text.contains("s=1 vs s=2: 20 common seeds, 0 right only with the first, 5 only with the second, p = 0.062"),
+            "{text}"
+        );
+        assert!(!text.contains("other        (defaults) vs"), "{text}");
+        let csv = summary_csv(&gs);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 4, "{csv}");
+        assert!(lines[0].starts_with("world,params,runs,failed,windows,windows_ok,"));
+        assert!(lines[2].starts_with("w,s=1,20,0,20,15,"), "{}", lines[2]);
+        assert!(lines[2].contains(",20,15,0.5313,0.8881,"), "{}", lines[2]);
+        assert!(lines[3].starts_with("w,s=2,21,1,"), "{}", lines[3]);
+        // The table carries the same block after its rows, and the failure.
+        let t = table(&rs);
+        assert!(
+            t.contains(&text) && t.contains("failed: w.ron [s=2] seed 21: boom"),
+            "{t}"
+        );
+    }
+
+    #[test]
+    fn no_interval_without_a_global_truth() {
+        let mut r = record("w", "", 1, true);
+        r.summary = Some(serde_json::json!({"windows": [], "global": {"betti": [1, 0]}}));
+        let gs = groups(&[r]);
+        assert_eq!(gs[0].global_runs, 0);
+        assert_eq!(confidence(&gs), "");
+        assert!(summary_csv(&gs).lines().nth(1).unwrap().contains(",0,0,,,"));
     }
 
     #[test]
