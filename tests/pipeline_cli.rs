@@ -356,6 +356,41 @@ fn model_file(dir: &Path, name: &str, h1_ratio: f64, h1_span: f64) -> std::path:
     path
 }
 
+/// A campaign rerun with `--model FILE` into a directory of runs judged by the shipped
+/// models maps them again (the stored runs are keyed by the model too) instead of reusing
+/// scores another model gave; a rerun with the same file reuses its own runs.
+#[test]
+fn eval_does_not_reuse_runs_judged_by_another_model() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("eval");
+    let eval = |model: Option<&Path>| {
+        let mut cmd = swarmmap();
+        if let Some(m) = model {
+            cmd.arg("--model").arg(m);
+        }
+        cmd.args(["eval", TINY, "--seeds", "1", "--quiet", "--out"])
+            .arg(&out)
+            .assert()
+            .success();
+        fs::read_to_string(out.join("eval.csv")).unwrap()
+    };
+    let shipped = eval(None);
+    // No H1 bar of a finite diagram has death / birth ≥ 10⁹: no window shows a hole.
+    let strict = model_file(tmp.path(), "strict.json", 1e9, 0.0);
+    let judged = eval(Some(&strict));
+    assert_eq!(fs::read_dir(out.join("runs")).unwrap().count(), 2);
+    let row = judged.lines().nth(1).unwrap();
+    let betti = row.split(',').nth(18).unwrap();
+    assert!(betti.split(' ').all(|w| w.ends_with(":0")), "{row}");
+    assert_ne!(
+        shipped, judged,
+        "the shipped model finds the tiny world's hole"
+    );
+    assert_eq!(eval(Some(&strict)), judged);
+    assert_eq!(eval(None), shipped);
+    assert_eq!(fs::read_dir(out.join("runs")).unwrap().count(), 2);
+}
+
 /// `swarmmap map DIR --model MODEL`.
 fn map_with(dir: &Path, model: &Path) -> assert_cmd::assert::Assert {
     swarmmap()

@@ -3,7 +3,10 @@
 //!
 //! Each finished run is stored as `DIR/runs/<key>.json` (its `summary.json` plus its
 //! parameters), written atomically, so an interrupted campaign resumes where it stopped:
-//! rerunning into the same directory skips every run whose file exists. A failing run is
+//! rerunning into the same directory skips every run whose file exists. The key changes
+//! with the world's text, the overrides, the seed and the models given with `--model`
+//! ([`Job::key`]), not with swarmmap's own code: after changing the mapping, use a new
+//! directory. A failing run is
 //! recorded with its error and the others go on. `DIR/eval.csv` has one row per run.
 
 use crate::io::write_atomic;
@@ -35,14 +38,26 @@ impl Job {
             .join(";")
     }
 
-    /// A file-name key that changes with the world's text, the overrides and the seed.
-    pub fn key(&self, world_text: &str) -> String {
-        run_key(
-            &self.world,
-            &[world_text.as_bytes(), self.params().as_bytes()],
-            self.seed,
-        )
+    /// A file-name key that changes with the world's text, the overrides, the seed and
+    /// `models`: the classifier models the run is judged with, when they are not the
+    /// shipped ones (`--model FILE`; [`models_part`]). Runs judged with the shipped models
+    /// keep the keys they had before models were part of it.
+    pub fn key(&self, world_text: &str, models: Option<&[u8]>) -> String {
+        let params = self.params();
+        let mut parts = vec![world_text.as_bytes(), params.as_bytes()];
+        parts.extend(models);
+        run_key(&self.world, &parts, self.seed)
     }
+}
+
+/// What a stored run's key takes from the models this process judges with: `None` for the
+/// shipped models, else their JSON. A window's robust holes, and so every score, depend on
+/// the model, so a campaign rerun with `--model FILE` into a directory of runs judged by
+/// other models must not reuse them.
+pub fn models_part() -> Option<Vec<u8>> {
+    use crate::mapping::classify::Models;
+    let active = Models::active();
+    (active != Models::shipped()).then(|| serde_json::to_vec(&active).unwrap_or_default())
 }
 
 /// A stored run's file-name key, `<world stem>-<12 hex digits>-s<seed>`: the hex digits are
@@ -154,6 +169,7 @@ pub fn run_campaign(
             texts.insert(j.world.clone(), std::fs::read_to_string(&j.world)?);
         }
     }
+    let models = models_part();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -162,7 +178,7 @@ pub fn run_campaign(
         jobs.par_iter()
             .map(|job| {
                 let text = &texts[&job.world];
-                let path = runs.join(format!("{}.json", job.key(text)));
+                let path = runs.join(format!("{}.json", job.key(text, models.as_deref())));
                 if let Ok(old) = std::fs::read_to_string(&path)
                     && let Ok(rec) = serde_json::from_str::<RunRecord>(&old)
                 {
@@ -608,6 +624,24 @@ pub fn summary_csv(groups: &[Group]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keys_change_with_the_models_only_when_given() {
+        let job = Job {
+            world: PathBuf::from("worlds/w.ron"),
+            overrides: vec![("a".into(), "1".into())],
+            seed: 3,
+        };
+        let plain = job.key("(name: \"w\")", None);
+        // The shipped models add nothing: keys stored before models were part of it stay.
+        let before = run_key(&job.world, &[b"(name: \"w\")", b"a=1"], 3);
+        assert_eq!(plain, before);
+        assert!(plain.starts_with("w-") && plain.ends_with("-s3"), "{plain}");
+        let m1 = job.key("(name: \"w\")", Some(b"{\"m\":1}"));
+        let m2 = job.key("(name: \"w\")", Some(b"{\"m\":2}"));
+        assert!(m1 != plain && m1 != m2, "{plain} {m1} {m2}");
+        assert_eq!(models_part(), None, "tests map with the shipped models");
+    }
 
     #[test]
     fn sweeps_expand_to_the_cartesian_product() {
