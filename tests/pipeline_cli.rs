@@ -304,7 +304,7 @@ fn eval_writes_one_row_per_run_and_resumes() {
         .assert()
         .success()
         .stdout(contains("tiny"))
-        .stdout(contains("with 95 % Wilson intervals"));
+        .stdout(contains("95% Wilson interval"));
     let csv = fs::read_to_string(out.join("eval.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
     // One summary row for the one (world, params) group, with the global figure's interval.

@@ -27,8 +27,7 @@ pub struct EvalArgs {
     #[arg(long = "set", value_name = "PATH=V1[,V2...]")]
     pub set: Vec<String>,
     /// Campaign directory: `runs/` (one file per finished run, reused on rerun), `eval.csv`
-    /// (one row per run) and `summary.csv` (one row per world and parameters) (default:
-    /// `runs/eval`).
+    /// (one row per run) and `summary.csv` (one row per world and parameters).
     #[arg(long, default_value = "runs/eval")]
     pub out: PathBuf,
     /// No progress bar.

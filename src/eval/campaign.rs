@@ -6,8 +6,8 @@
 //! rerunning into the same directory skips every run whose file exists. The key changes
 //! with the world's text, the overrides, the seed and the models given with `--model`
 //! ([`Job::key`]), not with swarmmap's own code: after changing the mapping, use a new
-//! directory. A failing run is
-//! recorded with its error and the others go on. `DIR/eval.csv` has one row per run.
+//! directory. A failing run is recorded with its error and the others go on.
+//! `DIR/eval.csv` has one row per run, `DIR/summary.csv` one per world and parameters.
 
 use crate::io::write_atomic;
 use crate::mapping::output::Summary;
@@ -57,7 +57,10 @@ impl Job {
 pub fn models_part() -> Option<Vec<u8>> {
     use crate::mapping::classify::Models;
     let active = Models::active();
-    (active != Models::shipped()).then(|| serde_json::to_vec(&active).unwrap_or_default())
+    // Plain data (numbers and strings; a non-finite number becomes `null`), so serializing
+    // cannot fail.
+    (active != Models::shipped())
+        .then(|| serde_json::to_vec(&active).expect("classifier models serialize to JSON"))
 }
 
 /// A stored run's file-name key, `<world stem>-<12 hex digits>-s<seed>`: the hex digits are
@@ -499,14 +502,17 @@ fn params_label(params: &str) -> &str {
     }
 }
 
-/// Pairs compared per world at most; past that, each group is compared with the first.
+/// A world with at most this many pairs of parameter sets has every pair compared; with
+/// more, each set is compared with the first (in the table's order) only.
 const MAX_PAIRS: usize = 15;
 
 /// How sure the global figures are ([`crate::eval::stats`]): each group's global (β0, β1)
 /// right in k of n runs with its 95 % Wilson interval, and, for every world run with
-/// several parameter sets, each pair of them compared on the seeds both ran (the seeds
-/// right under one only, and the exact McNemar p-value). Empty when no run has a global
-/// truth. Window shares get no interval: one run's windows are not independent draws.
+/// several parameter sets, pairs of them compared on the seeds both ran (the seeds right
+/// under one only, and the exact McNemar p-value; every pair up to [`MAX_PAIRS`], else each
+/// set against the first). Failed runs have no map and are left out, as in the table. Empty
+/// when no run has a global truth. Window shares get no interval: one run's windows are not
+/// independent draws.
 pub fn confidence(groups: &[Group]) -> String {
     use crate::eval::stats::{Z95, mcnemar_exact, wilson};
     let mut out = String::new();
@@ -514,11 +520,11 @@ pub fn confidence(groups: &[Group]) -> String {
     if with_truth.is_empty() {
         return out;
     }
-    out.push_str("global ok over independent runs, with 95 % Wilson intervals:\n");
+    out.push_str("global ok over independent runs (failed runs left out), 95% Wilson interval:\n");
     for g in &with_truth {
         let (lo, hi) = wilson(g.global_ok, g.global_runs, Z95).unwrap_or((0.0, 1.0));
         out.push_str(&format!(
-            "  {:<12} {:<31} {:>4} of {:<4} {:>6}  [{:.1} %, {:.1} %]\n",
+            "  {:<12} {:<31} {:>4} of {:<4} {:>6}  [{:.1}%, {:.1}%]\n",
             g.world,
             params_label(&g.params),
             g.global_ok,
@@ -532,44 +538,60 @@ pub fn confidence(groups: &[Group]) -> String {
     for g in &with_truth {
         by_world.entry(g.world.as_str()).or_default().push(g);
     }
-    let mut pairs = Vec::new();
-    for gs in by_world.values().filter(|gs| gs.len() > 1) {
+    let mut lines = String::new();
+    for (world, gs) in by_world.iter().filter(|(_, gs)| gs.len() > 1) {
         let all = gs.len() * (gs.len() - 1) / 2 <= MAX_PAIRS;
+        if !all {
+            lines.push_str(&format!(
+                "  {world}: {} parameter sets, each compared with the first only\n",
+                gs.len()
+            ));
+        }
         for i in 0..gs.len() {
             for j in i + 1..gs.len() {
-                if all || i == 0 {
-                    pairs.push((gs[i], gs[j]));
+                if !all && i > 0 {
+                    continue;
                 }
+                let (a, b) = (gs[i], gs[j]);
+                let (mut common, mut only_a, mut only_b) = (0, 0, 0);
+                for (seed, ok_a) in &a.global_by_seed {
+                    if let Some(ok_b) = b.global_by_seed.get(seed) {
+                        common += 1;
+                        only_a += usize::from(*ok_a && !ok_b);
+                        only_b += usize::from(*ok_b && !ok_a);
+                    }
+                }
+                lines.push_str(&format!(
+                    "  {world}: {} vs {}: {common} common seeds",
+                    params_label(&a.params),
+                    params_label(&b.params),
+                ));
+                if common > 0 {
+                    lines.push_str(&format!(
+                        ", right only with the first on {only_a}, only with the second on {only_b}, {}",
+                        p_value(mcnemar_exact(only_a, only_b))
+                    ));
+                }
+                lines.push('\n');
             }
         }
     }
-    if pairs.is_empty() {
-        return out;
-    }
-    out.push_str(
-        "global ok, paired by seed (seeds right under one setting only; exact McNemar test):\n",
-    );
-    for (a, b) in pairs {
-        let (mut common, mut only_a, mut only_b) = (0, 0, 0);
-        for (seed, ok_a) in &a.global_by_seed {
-            if let Some(ok_b) = b.global_by_seed.get(seed) {
-                common += 1;
-                only_a += usize::from(*ok_a && !ok_b);
-                only_b += usize::from(*ok_b && !ok_a);
-            }
-        }
-        if common == 0 {
-            continue;
-        }
-        out.push_str(&format!(
-            "  {:<12} {} vs {}: {common} common seeds, {only_a} right only with the first, {only_b} only with the second, p = {:.3}\n",
-            a.world,
-            params_label(&a.params),
-            params_label(&b.params),
-            mcnemar_exact(only_a, only_b)
-        ));
+    if !lines.is_empty() {
+        out.push_str(
+            "global ok, paired by seed (exact McNemar test; p per pair, not corrected for multiple comparisons):\n",
+        );
+        out.push_str(&lines);
     }
     out
+}
+
+/// `p = 0.0625` (four decimals), or `p < 0.0001`.
+fn p_value(p: f64) -> String {
+    if p < 1e-4 {
+        "p < 0.0001".to_string()
+    } else {
+        format!("p = {p:.4}")
+    }
 }
 
 /// `summary.csv`: one row per (world, params), the counts behind the table and the global
@@ -705,20 +727,17 @@ mod tests {
         );
         let text = confidence(&gs);
         // 15 of 20: statsmodels' Wilson interval [0.5313, 0.8881].
+        assert!(text.contains("15 of 20    75.0%  [53.1%, 88.8%]"), "{text}");
         assert!(
-            text.contains("15 of 20    75.0%  [53.1 %, 88.8 %]"),
-            "{text}"
-        );
-        assert!(
-            text.contains("20 of 20   100.0%  [83.9 %, 100.0 %]"),
+            text.contains("20 of 20   100.0%  [83.9%, 100.0%]"),
             "{text}"
         );
         // Five seeds right only with the second setting: p = 2 / 2^5.
         assert!(
-            text.contains("s=1 vs s=2: 20 common seeds, 0 right only with the first, 5 only with the second, p = 0.062"),
+            text.contains("w: s=1 vs s=2: 20 common seeds, right only with the first on 0, only with the second on 5, p = 0.0625"),
             "{text}"
         );
-        assert!(!text.contains("other        (defaults) vs"), "{text}");
+        assert!(!text.contains("other: "), "{text}");
         let csv = summary_csv(&gs);
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 4, "{csv}");
@@ -731,6 +750,29 @@ mod tests {
         assert!(
             t.contains(&text) && t.contains("failed: w.ron [s=2] seed 21: boom"),
             "{t}"
+        );
+    }
+
+    #[test]
+    fn many_parameter_sets_are_compared_with_the_first_only() {
+        // Seven sets give 21 pairs, over MAX_PAIRS: six comparisons, each with `s=0`.
+        // `s=0` is right on seeds 1-30; the others on none: p = 2 / 2^30.
+        let mut rs = Vec::new();
+        for k in 0..7 {
+            for seed in 1..=30 {
+                rs.push(record("w", &format!("s={k}"), seed, k == 0));
+            }
+        }
+        let text = confidence(&groups(&rs));
+        assert!(
+            text.contains("w: 7 parameter sets, each compared with the first only"),
+            "{text}"
+        );
+        assert_eq!(text.matches(" vs ").count(), 6, "{text}");
+        assert_eq!(text.matches("w: s=0 vs ").count(), 6, "{text}");
+        assert!(
+            text.contains("on 30, only with the second on 0, p < 0.0001"),
+            "{text}"
         );
     }
 
