@@ -250,7 +250,10 @@ fn finish(
                 truth: truth.as_ref().map(|(world, fs)| {
                     let a = window_band(world, w[0].start, w[0].end);
                     let b = window_band(world, w[1].start, w[1].end);
-                    overlap(a, b).map_or(0, |(x0, x1)| fs.components_in_band(x0, x1))
+                    // What the swarm could have reached by the overlap's end (W_i's end).
+                    overlap(a, b).map_or(0, |(x0, x1)| {
+                        fs.reached_by(world, w[0].end).components_in_band(x0, x1)
+                    })
                 }),
             })
             .collect();

@@ -499,3 +499,87 @@ fn paper_sized_arena_is_fast() {
     assert!(build < 3.0 * slack, "build took {build} s");
     assert!(query < 0.1 * slack, "band query took {query} s");
 }
+
+/// A U-shaped obstacle (outer x 4–6 m, y 1.5–3.5 m, arms 0.3 m thick) whose pocket opens
+/// towards `+x` (or `−x`): three rectangles.
+fn u_shape(open_right: bool) -> Vec<Obstacle> {
+    let (back, arms) = if open_right {
+        (rect(4.0, 1.5, 4.3, 3.5), (4.0, 6.0))
+    } else {
+        (rect(5.7, 1.5, 6.0, 3.5), (4.0, 6.0))
+    };
+    vec![
+        back,
+        rect(arms.0, 1.5, arms.1, 1.8),
+        rect(arms.0, 3.2, arms.1, 3.5),
+    ]
+}
+
+/// A window's truth is R as it stood at the window's end: a pocket of the window's band
+/// whose entrance the domain reaches only later is no space the window can map
+/// (`worlds/nonconvex.ron`'s W1), while over the whole run it is part of R.
+#[test]
+fn a_pocket_that_opens_ahead_counts_once_the_domain_reaches_its_entrance() {
+    for &h in &RESOLUTIONS {
+        for open_right in [true, false] {
+            let mut w = world(u_shape(open_right));
+            if !open_right {
+                // The mirror image: a leftward sweep from x = 8.5 m, the pocket opening at
+                // x = 4 m.
+                w.leader.start_x = 8.5;
+                w.leader.end_x = 1.5;
+            }
+            let fs = FreeSpace::new(&w, h).unwrap();
+            let at = |lead: f64| {
+                // The time at which the domain's leading edge (1.5 m ahead of the leader)
+                // stands at `lead`.
+                let travelled = if open_right { lead - 3.0 } else { 7.0 - lead };
+                w.simulation.dispersion_time + travelled / w.leader.speed
+            };
+            let name = if open_right { "rightward" } else { "leftward" };
+            // The band up to x = 5 m (from x = 5 m leftward): the pocket's inner part is
+            // cut off by the band's edge; its entrance (x = 6 m, or 4 m) is still ahead.
+            let (t1, band1) = if open_right {
+                (at(5.0), (0.0, 5.0))
+            } else {
+                (at(5.0), (5.0, 10.0))
+            };
+            let early = fs.reached_by(&w, t1);
+            assert_eq!(
+                early.betti_in_band(band1.0, band1.1),
+                [1, 0],
+                "{name} at {h} m"
+            );
+            assert_eq!(early.components_in_band(band1.0, band1.1), 1);
+            assert_eq!(early.label_band(band1.0, band1.1).count(), 1);
+            assert!(early.holes_in_band(band1.0, band1.1).is_empty());
+            // All of R holds the pocket: a second component in the same band.
+            assert_eq!(
+                fs.betti_in_band(band1.0, band1.1),
+                [2, 0],
+                "{name} at {h} m"
+            );
+            // Once the leading edge has passed the entrance the pocket is reached, and the
+            // U, wholly inside the band, is a hole.
+            let (t2, band2) = if open_right {
+                (at(6.5), (0.0, 6.5))
+            } else {
+                (at(3.5), (3.5, 10.0))
+            };
+            let later = fs.reached_by(&w, t2);
+            assert_eq!(
+                later.betti_in_band(band2.0, band2.1),
+                [1, 1],
+                "{name} at {h} m"
+            );
+            assert_eq!(later.holes_in_band(band2.0, band2.1).len(), 1);
+            assert_eq!(fs.betti_in_band(band2.0, band2.1), [1, 1]);
+            // At the end of the run, and after it, R is all of R.
+            for t in [w.total_duration(), w.total_duration() + 1.0] {
+                assert_eq!(fs.reached_by(&w, t).betti_in_band(0.0, 10.0), [1, 1]);
+                assert_eq!(fs.reached_by(&w, t).betti_in_band(band1.0, band1.1), [2, 0]);
+            }
+            assert_eq!(fs.global_betti(), [1, 1]);
+        }
+    }
+}

@@ -338,7 +338,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                     .iter()
                     .map(|w| {
                         let (a, b) = window_band(world, w.start, w.end);
-                        fs.betti_in_band(a, b)
+                        fs.reached_by(world, w.end).betti_in_band(a, b)
                     })
                     .collect();
                 let mut fits = Vec::new();

@@ -17,19 +17,28 @@
 //!   opens only ahead of the swarm, and only where the domain has already passed it (the
 //!   lanes beside `worlds/corridor.ron`'s corridor, which no agent enters before x = 17 m),
 //!   is not counted. Computed on the raster by a flood fill that follows the domain's
-//!   leading edge column by column (`swept`): each cell enters once. On every other bundled and
-//!   training world R is the whole of F's components that meet the placement, as it was
-//!   before this rule (ninth session; README, "Ground truth").
+//!   leading edge column by column (`swept`): each cell enters once, and records the step at
+//!   which it did. On every other bundled and training world R is the whole of F's
+//!   components that meet the placement, as it was before this rule (ninth session; README,
+//!   "Ground truth").
+//! - **R by a time t** ([`FreeSpace::reached_by`]): the part of R the sweep has entered by
+//!   t. R only grows, and a cell enters it when the domain's leading edge reaches a place
+//!   from which the swarm can walk to it inside D(t).
 //! - **A window's truth.** The domain of window W_i = [a, b] is the band
 //!   D_i = ∪_{t∈W_i} D(t) = [domain(a).0, domain(b).1] (the leader moves monotonically; see
-//!   [`window_band`]). β0 is the number of components of R ∩ D_i. β1 counts the holes that
-//!   lie wholly inside the band: bounded components of the complement of R ∩ D_i that touch
-//!   neither the band's left or right edge nor the arena's top or bottom wall. An obstacle
-//!   cut by the band's edge, or touching (within 2r of) a wall, is part of the outside, not
-//!   a hole: the swarm cannot walk around it inside the band.
-//! - **Connections between windows i and i+1.** The number of components of R inside the
-//!   overlap band D_i ∩ D_{i+1} ([`overlap`]): each is a corridor through which the two local
-//!   maps are glued.
+//!   [`window_band`]). β0 is the number of components of R(b) ∩ D_i, R as it stood at the
+//!   window's end: free space of the band that the swarm can enter only later (a pocket
+//!   whose entrance lies ahead of D(t) throughout the window, like the U of
+//!   `worlds/nonconvex.ron` in its W1) holds no encounter of the window. β1 counts the holes
+//!   that lie wholly inside the band: bounded components of the complement of R(b) ∩ D_i
+//!   that touch neither the band's left or right edge nor the arena's top or bottom wall. An
+//!   obstacle cut by the band's edge, or touching (within 2r of) a wall, is part of the
+//!   outside, not a hole: the swarm cannot walk around it inside the band. (Space not yet
+//!   entered by b reaches the band's leading edge, since it can only be entered from beyond
+//!   it, so it never closes a hole that R does not have.)
+//! - **Connections between windows i and i+1.** The number of components of R(b) inside the
+//!   overlap band D_i ∩ D_{i+1} ([`overlap`]), b the end of W_i and of the overlap: each is
+//!   a corridor through which the two local maps are glued.
 //! - **Global truth.** (β0, β1) of R over the whole arena.
 //!
 //! # Method: a cached raster
@@ -115,6 +124,12 @@ pub struct FreeSpace {
     ny: usize,
     /// Column-major: cell `(i, j)` (column i, row j) is at `i * ny + j`.
     reach: Vec<bool>,
+    /// When each cell of R entered it: the number of columns the domain's leading edge had
+    /// advanced past its start (0 for the dispersion's flood); `NONE` off R.
+    entered: Vec<u32>,
+    /// The leading edge's column at t = 0, and whether it moves right (else left).
+    lead_start: usize,
+    rightward: bool,
     /// Label of the reachable component of each cell (`NONE` off R).
     comp: Vec<u32>,
     components: usize,
@@ -263,7 +278,8 @@ impl FreeSpace {
                 }
             }
         }
-        let reach = swept(&free, &seeds, world, h, nx, ny);
+        let sweep = swept(&free, &seeds, world, h, nx, ny);
+        let reach: Vec<bool> = sweep.entered.iter().map(|&e| e != NONE).collect();
         let (comp, components) = label_4(&reach, nx, ny);
         let holes = count_holes_8(&reach, nx, ny);
         Ok(Self {
@@ -272,6 +288,9 @@ impl FreeSpace {
             nx,
             ny,
             reach,
+            entered: sweep.entered,
+            lead_start: sweep.lead_start,
+            rightward: sweep.rightward,
             comp,
             components,
             holes,
@@ -327,16 +346,103 @@ impl FreeSpace {
         snap(p, self.resolution, self.nx, self.ny, |k| self.comp[k])
     }
 
+    /// R as it stood at time `t` of the run (seconds): the cells the swarm could have walked
+    /// into by then, while staying in the moving domain. A window's truth and the truth of
+    /// the connections at its end are taken at the window's end: free space that only opens
+    /// to the swarm later (a pocket of the window's band whose entrance D(t) reaches after
+    /// the window) is no space the window's encounters can map. `world` must be the world
+    /// this raster was built from.
+    pub fn reached_by(&self, world: &World, t: f64) -> Reached<'_> {
+        if t >= world.total_duration() {
+            return self.reached();
+        }
+        let (a, b) = world.domain(t);
+        let h = self.resolution;
+        // The leading edge has passed the columns whose centres it has reached, as in `swept`.
+        let step = if self.rightward {
+            let lead = ((b / h - 0.5).floor().max(0.0) as usize).min(self.nx - 1);
+            lead.saturating_sub(self.lead_start)
+        } else {
+            let lead = ((a / h - 0.5).ceil().max(0.0) as usize).min(self.nx - 1);
+            self.lead_start.saturating_sub(lead)
+        };
+        Reached {
+            fs: self,
+            step: u32::try_from(step).unwrap_or(NONE - 1),
+        }
+    }
+
+    /// All of R, as the sweep leaves it: the global truth's space.
+    pub fn reached(&self) -> Reached<'_> {
+        Reached {
+            fs: self,
+            step: NONE - 1,
+        }
+    }
+
     /// True (β0, β1) of R ∩ [x0, x1] × [0, height] (x in metres; the band holds the columns
     /// whose centres lie in [x0, x1]; an empty or non-finite band gives `[0, 0]`).
     pub fn betti_in_band(&self, x0: f64, x1: f64) -> [usize; 2] {
-        match self.columns(x0, x1) {
+        self.reached().betti_in_band(x0, x1)
+    }
+
+    /// Number of components of R ∩ [x0, x1] × [0, height] (β0 of the band).
+    pub fn components_in_band(&self, x0: f64, x1: f64) -> usize {
+        self.reached().components_in_band(x0, x1)
+    }
+
+    /// Labels the components of R ∩ [x0, x1] × [0, height], for matching points to them.
+    pub fn label_band(&self, x0: f64, x1: f64) -> BandComponents {
+        self.reached().label_band(x0, x1)
+    }
+
+    /// The holes of R ∩ [x0, x1] × [0, height] ([`Reached::holes_in_band`]).
+    pub fn holes_in_band(&self, x0: f64, x1: f64) -> Vec<TrueHole> {
+        self.reached().holes_in_band(x0, x1)
+    }
+
+    /// The columns whose centres lie in [x0, x1], or `None` if there are none.
+    fn columns(&self, x0: f64, x1: f64) -> Option<(usize, usize)> {
+        index_range(x0, x1, self.resolution, self.nx)
+    }
+
+    fn cell_of(&self, p: Vec2) -> Option<(usize, usize)> {
+        cell_of(p, self.resolution, self.nx, self.ny)
+    }
+}
+
+/// R as it stood at one moment of the sweep ([`FreeSpace::reached_by`], or all of it:
+/// [`FreeSpace::reached`]); answers the same band queries as [`FreeSpace`].
+#[derive(Debug, Clone, Copy)]
+pub struct Reached<'a> {
+    fs: &'a FreeSpace,
+    /// Cells that entered R at this step of the sweep or before are in it.
+    step: u32,
+}
+
+impl Reached<'_> {
+    /// The band's columns `c0..=c1` of this R: a slice of the raster when it is all of R
+    /// there, else a copy with the later cells cleared.
+    fn band(&self, c0: usize, c1: usize) -> std::borrow::Cow<'_, [bool]> {
+        let range = c0 * self.fs.ny..(c1 + 1) * self.fs.ny;
+        let entered = &self.fs.entered[range.clone()];
+        if entered.iter().all(|&e| e == NONE || e <= self.step) {
+            std::borrow::Cow::Borrowed(&self.fs.reach[range])
+        } else {
+            std::borrow::Cow::Owned(entered.iter().map(|&e| e <= self.step).collect())
+        }
+    }
+
+    /// True (β0, β1) of R ∩ [x0, x1] × [0, height] (x in metres; the band holds the columns
+    /// whose centres lie in [x0, x1]; an empty or non-finite band gives `[0, 0]`).
+    pub fn betti_in_band(&self, x0: f64, x1: f64) -> [usize; 2] {
+        match self.fs.columns(x0, x1) {
             None => [0, 0],
             Some((c0, c1)) => {
-                let slice = &self.reach[c0 * self.ny..(c1 + 1) * self.ny];
+                let slice = self.band(c0, c1);
                 let ncols = c1 - c0 + 1;
-                let (_, b0) = label_4(slice, ncols, self.ny);
-                [b0, count_holes_8(slice, ncols, self.ny)]
+                let (_, b0) = label_4(&slice, ncols, self.fs.ny);
+                [b0, count_holes_8(&slice, ncols, self.fs.ny)]
             }
         }
     }
@@ -349,24 +455,24 @@ impl FreeSpace {
 
     /// Labels the components of R ∩ [x0, x1] × [0, height], for matching points to them.
     pub fn label_band(&self, x0: f64, x1: f64) -> BandComponents {
-        match self.columns(x0, x1) {
+        match self.fs.columns(x0, x1) {
             None => BandComponents {
-                resolution: self.resolution,
+                resolution: self.fs.resolution,
                 c0: 0,
                 ncols: 0,
-                ny: self.ny,
+                ny: self.fs.ny,
                 labels: Vec::new(),
                 count: 0,
             },
             Some((c0, c1)) => {
-                let slice = &self.reach[c0 * self.ny..(c1 + 1) * self.ny];
+                let slice = self.band(c0, c1);
                 let ncols = c1 - c0 + 1;
-                let (labels, count) = label_4(slice, ncols, self.ny);
+                let (labels, count) = label_4(&slice, ncols, self.fs.ny);
                 BandComponents {
-                    resolution: self.resolution,
+                    resolution: self.fs.resolution,
                     c0,
                     ncols,
-                    ny: self.ny,
+                    ny: self.fs.ny,
                     labels,
                     count,
                 }
@@ -374,23 +480,23 @@ impl FreeSpace {
         }
     }
 
-    /// The holes of R ∩ [x0, x1] × [0, height], the ones [`FreeSpace::betti_in_band`]
+    /// The holes of R ∩ [x0, x1] × [0, height], the ones [`Reached::betti_in_band`]
     /// counts as β1 (same raster, same rule), in order of their first cell (column-major),
     /// for telling which of them a map found ([`crate::eval::holes`]).
     pub fn holes_in_band(&self, x0: f64, x1: f64) -> Vec<TrueHole> {
-        let Some((c0, c1)) = self.columns(x0, x1) else {
+        let Some((c0, c1)) = self.fs.columns(x0, x1) else {
             return Vec::new();
         };
-        let ny = self.ny;
-        let slice = &self.reach[c0 * ny..(c1 + 1) * ny];
-        let h = self.resolution;
+        let ny = self.fs.ny;
+        let slice = self.band(c0, c1);
+        let h = self.fs.resolution;
         let centre = |k: usize| {
             [
                 ((c0 + k / ny) as f64 + 0.5) * h,
                 ((k % ny) as f64 + 0.5) * h,
             ]
         };
-        hole_cells_8(slice, c1 - c0 + 1, ny)
+        hole_cells_8(&slice, c1 - c0 + 1, ny)
             .into_iter()
             .map(|cells| {
                 let n = cells.len();
@@ -418,15 +524,6 @@ impl FreeSpace {
                 }
             })
             .collect()
-    }
-
-    /// The columns whose centres lie in [x0, x1], or `None` if there are none.
-    fn columns(&self, x0: f64, x1: f64) -> Option<(usize, usize)> {
-        index_range(x0, x1, self.resolution, self.nx)
-    }
-
-    fn cell_of(&self, p: Vec2) -> Option<(usize, usize)> {
-        cell_of(p, self.resolution, self.nx, self.ny)
     }
 }
 
@@ -465,89 +562,95 @@ pub fn overlap(a: (f64, f64), b: (f64, f64)) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
+/// R as the sweep builds it ([`swept`]).
+struct Sweep {
+    /// Per cell: the step at which it entered R (see [`FreeSpace`]'s `entered`), or `NONE`.
+    entered: Vec<u32>,
+    lead_start: usize,
+    rightward: bool,
+}
+
 /// The cells of the free space `reach` that the swarm can visit while it stays in the moving
-/// domain D(t):
-/// flood fill from the placement's cells `seeds` inside D(0) (the dispersion), then, as
-/// the domain's leading edge (its right edge, or its left one for a leftward sweep) passes
-/// each column, from that column's cells next to a visited one, over unvisited cells of
-/// `reach` inside the domain at that moment. A cell enters
+/// domain D(t), and when each enters:
+/// flood fill from the placement's cells `seeds` inside D(0) (the dispersion; step 0), then,
+/// as the domain's leading edge (its right edge, or its left one for a leftward sweep)
+/// passes each column (step k after k columns), from that column's cells next to a visited
+/// one, over unvisited cells of `reach` inside the domain at that moment. A cell enters
 /// once, so the cost is O(cells) plus one pass over each column.
-fn swept(
-    reach: &[bool],
-    seeds: &[usize],
-    world: &World,
-    h: f64,
-    nx: usize,
-    ny: usize,
-) -> Vec<bool> {
-    let mut visited = vec![false; nx * ny];
+fn swept(reach: &[bool], seeds: &[usize], world: &World, h: f64, nx: usize, ny: usize) -> Sweep {
+    let mut entered = vec![NONE; nx * ny];
     // Columns whose centres lie in [a, b].
     let cols = |a: f64, b: f64| -> (usize, usize) {
         let c0 = ((a / h - 0.5).ceil().max(0.0) as usize).min(nx - 1);
         let c1 = (((b / h - 0.5).floor()).max(0.0) as usize).min(nx - 1);
         (c0, c1.max(c0))
     };
-    let flood = |visited: &mut Vec<bool>, stack: &mut Vec<usize>, c0: usize, c1: usize| {
-        while let Some(k) = stack.pop() {
-            let (i, j) = (k / ny, k % ny);
-            let mut push = |ii: usize, jj: usize| {
-                let q = ii * ny + jj;
-                if ii >= c0 && ii <= c1 && reach[q] && !visited[q] {
-                    visited[q] = true;
-                    stack.push(q);
+    let flood =
+        |entered: &mut Vec<u32>, stack: &mut Vec<usize>, c0: usize, c1: usize, step: u32| {
+            while let Some(k) = stack.pop() {
+                let (i, j) = (k / ny, k % ny);
+                let mut push = |ii: usize, jj: usize| {
+                    let q = ii * ny + jj;
+                    if ii >= c0 && ii <= c1 && reach[q] && entered[q] == NONE {
+                        entered[q] = step;
+                        stack.push(q);
+                    }
+                };
+                if i > 0 {
+                    push(i - 1, j);
                 }
-            };
-            if i > 0 {
-                push(i - 1, j);
+                if i + 1 < nx {
+                    push(i + 1, j);
+                }
+                if j > 0 {
+                    push(i, j - 1);
+                }
+                if j + 1 < ny {
+                    push(i, j + 1);
+                }
             }
-            if i + 1 < nx {
-                push(i + 1, j);
-            }
-            if j > 0 {
-                push(i, j - 1);
-            }
-            if j + 1 < ny {
-                push(i, j + 1);
-            }
-        }
-    };
+        };
     let (a0, b0) = world.domain(0.0);
     let (c0_start, c1_start) = cols(a0, b0);
     // The placement may reach past D(0): its agents start there and walk back into it.
     let (mut lo, mut hi) = (c0_start, c1_start);
     let mut stack: Vec<usize> = Vec::new();
     for &k in seeds {
-        if reach[k] && !visited[k] {
-            visited[k] = true;
+        if reach[k] && entered[k] == NONE {
+            entered[k] = 0;
             stack.push(k);
             lo = lo.min(k / ny);
             hi = hi.max(k / ny);
         }
     }
-    flood(&mut visited, &mut stack, lo, hi);
+    flood(&mut entered, &mut stack, lo, hi, 0);
     let (mut c0, mut c1) = (c0_start, c1_start);
     let (a_end, b_end) = world.domain(world.total_duration());
     let width = b0 - a0;
     // The leading edge moves one column at a time (right, or left for a leftward sweep);
     // the new column's cells next to a visited one enter, and the flood goes on inside the
     // domain of that moment.
-    let mut enter = |visited: &mut Vec<bool>, column: usize, from: usize, c0: usize, c1: usize| {
-        for j in 0..ny {
-            let k = column * ny + j;
-            if reach[k] && !visited[k] && visited[from * ny + j] {
-                visited[k] = true;
-                stack.push(k);
+    let mut enter =
+        |entered: &mut Vec<u32>, column: usize, from: usize, c0: usize, c1: usize, step: u32| {
+            for j in 0..ny {
+                let k = column * ny + j;
+                if reach[k] && entered[k] == NONE && entered[from * ny + j] != NONE {
+                    entered[k] = step;
+                    stack.push(k);
+                }
             }
-        }
-        flood(visited, &mut stack, c0, c1);
-    };
-    if world.leader.end_x >= world.leader.start_x {
+            flood(entered, &mut stack, c0, c1, step);
+        };
+    // Steps count columns; a raster has far fewer than `NONE` of them (`MAX_CELLS`).
+    let step_of = |k: usize| u32::try_from(k).unwrap_or(NONE - 1);
+    let rightward = world.leader.end_x >= world.leader.start_x;
+    if rightward {
         let (_, last) = cols(b_end, b_end);
         while c1 < last {
             c1 += 1;
             let right = (c1 as f64 + 0.5) * h;
             c0 = cols(right - width, right).0.max(c0);
-            enter(&mut visited, c1, c1 - 1, c0, c1);
+            enter(&mut entered, c1, c1 - 1, c0, c1, step_of(c1 - c1_start));
         }
     } else {
         let (first, _) = cols(a_end, a_end);
@@ -555,10 +658,14 @@ fn swept(
             c0 -= 1;
             let left = (c0 as f64 + 0.5) * h;
             c1 = cols(left, left + width).1.min(c1);
-            enter(&mut visited, c0, c0 + 1, c0, c1);
+            enter(&mut entered, c0, c0 + 1, c0, c1, step_of(c0_start - c0));
         }
     }
-    visited
+    Sweep {
+        entered,
+        lead_start: if rightward { c1_start } else { c0_start },
+        rightward,
+    }
 }
 
 /// Indices k in `0..n` whose cell centres `(k + 0.5) h` lie in [lo, hi], or `None`.

@@ -184,14 +184,14 @@ pub fn summarise_window(
         betti: m.betti,
         truth: truth
             .zip(band)
-            .map(|((_, fs), (a, b))| fs.betti_in_band(a, b)),
+            .map(|((w, fs), (a, b))| fs.reached_by(w, m.end).betti_in_band(a, b)),
         domain: band.map(|(a, b)| [a, b]),
-        holes: truth.zip(band).and_then(|((_, fs), (a, b))| {
+        holes: truth.zip(band).and_then(|((w, fs), (a, b))| {
             let positions = true_positions(m, log)?;
             Some(crate::eval::holes::check(
                 m,
                 &positions,
-                &fs.holes_in_band(a, b),
+                &fs.reached_by(w, m.end).holes_in_band(a, b),
             ))
         }),
         fidelity: fidelity(
