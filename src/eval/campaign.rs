@@ -448,15 +448,19 @@ pub fn groups(records: &[RunRecord]) -> Vec<Group> {
 /// parameter sets, their paired comparisons ([`confidence`]).
 pub fn table(records: &[RunRecord]) -> String {
     let groups = groups(records);
-    let mut out = String::from(
-        "world        params                          runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  glob. holes  spearman  procr.  s/run\n",
-    );
-    for g in &groups {
+    let labels = Labels::of(&groups);
+    let (ww, pw) = (labels.world_width, labels.params_width);
+    let mut out = labels.preamble();
+    out.push_str(&format!(
+        "{:<ww$} {:<pw$} runs fail  windows ok  β0 ok   β1 ok   holes ok  no-hole ok  oracle ok  conn ok   global ok  glob. holes  spearman  procr.  s/run\n",
+        "world", "params"
+    ));
+    for (g, label) in groups.iter().zip(&labels.params) {
         let s = &g.sum;
         out.push_str(&format!(
-            "{:<12} {:<31} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8.2}  {:>6.3}  {:>5.1}\n",
+            "{:<ww$} {:<pw$} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8.2}  {:>6.3}  {:>5.1}\n",
             g.world,
-            if g.params.is_empty() { "(defaults)" } else { &g.params },
+            label,
             g.runs,
             g.failed,
             pct(s.windows_ok, s.windows),
@@ -486,19 +490,84 @@ pub fn table(records: &[RunRecord]) -> String {
     out
 }
 
+/// How the table names its groups: the `--set` values every group shares are printed once
+/// above it, and each row shows only its own (a sweep's values), so a long list of fixed
+/// overrides does not push the figures out of line.
+struct Labels {
+    /// `path=value` settings of every group, in the order of the first group's.
+    common: Vec<String>,
+    /// Per group: its other settings joined by `;`, `(defaults)` for a group without
+    /// settings, or `(settings above)` when all of its settings are common.
+    params: Vec<String>,
+    world_width: usize,
+    params_width: usize,
+}
+
+impl Labels {
+    fn of(groups: &[Group]) -> Self {
+        let split = |p: &str| -> Vec<String> {
+            p.split(';')
+                .filter(|x| !x.is_empty())
+                .map(str::to_string)
+                .collect()
+        };
+        let sets: Vec<Vec<String>> = groups.iter().map(|g| split(&g.params)).collect();
+        let common: Vec<String> = match sets.first() {
+            Some(first) => first
+                .iter()
+                .filter(|kv| sets.iter().all(|s| s.contains(kv)))
+                .cloned()
+                .collect(),
+            None => Vec::new(),
+        };
+        let params: Vec<String> = sets
+            .iter()
+            .map(|set| {
+                let own: Vec<&str> = set
+                    .iter()
+                    .filter(|kv| !common.contains(kv))
+                    .map(String::as_str)
+                    .collect();
+                if !own.is_empty() {
+                    own.join(";")
+                } else if set.is_empty() {
+                    "(defaults)".to_string()
+                } else {
+                    "(settings above)".to_string()
+                }
+            })
+            .collect();
+        let world_width = groups
+            .iter()
+            .map(|g| g.world.chars().count())
+            .fold(12, usize::max);
+        let params_width = params
+            .iter()
+            .map(|p| p.chars().count())
+            .fold(31, usize::max);
+        Self {
+            common,
+            params,
+            world_width,
+            params_width,
+        }
+    }
+
+    /// `settings of every run: a=1; b=2` and a newline, or nothing.
+    fn preamble(&self) -> String {
+        if self.common.is_empty() {
+            String::new()
+        } else {
+            format!("settings of every run: {}\n", self.common.join("; "))
+        }
+    }
+}
+
 fn pct(a: usize, b: usize) -> String {
     if b == 0 {
         "    -".to_string()
     } else {
         format!("{:>5.1}%", 100.0 * a as f64 / b as f64)
-    }
-}
-
-fn params_label(params: &str) -> &str {
-    if params.is_empty() {
-        "(defaults)"
-    } else {
-        params
     }
 }
 
@@ -520,13 +589,21 @@ pub fn confidence(groups: &[Group]) -> String {
     if with_truth.is_empty() {
         return out;
     }
+    let labels = Labels::of(groups);
+    let label = |g: &Group| -> &str {
+        groups
+            .iter()
+            .position(|x| std::ptr::eq(x, g))
+            .map_or("", |i| labels.params[i].as_str())
+    };
+    let (ww, pw) = (labels.world_width, labels.params_width);
     out.push_str("global ok over independent runs (failed runs left out), 95% Wilson interval:\n");
     for g in &with_truth {
         let (lo, hi) = wilson(g.global_ok, g.global_runs, Z95).unwrap_or((0.0, 1.0));
         out.push_str(&format!(
-            "  {:<12} {:<31} {:>4} of {:<4} {:>6}  [{:.1}%, {:.1}%]\n",
+            "  {:<ww$} {:<pw$} {:>4} of {:<4} {:>6}  [{:.1}%, {:.1}%]\n",
             g.world,
-            params_label(&g.params),
+            label(g),
             g.global_ok,
             g.global_runs,
             pct(g.global_ok, g.global_runs),
@@ -563,8 +640,8 @@ pub fn confidence(groups: &[Group]) -> String {
                 }
                 lines.push_str(&format!(
                     "  {world}: {} vs {}: {common} common seeds",
-                    params_label(&a.params),
-                    params_label(&b.params),
+                    label(a),
+                    label(b),
                 ));
                 if common > 0 {
                     lines.push_str(&format!(
@@ -773,6 +850,35 @@ mod tests {
         assert!(
             text.contains("on 30, only with the second on 0, p < 0.0001"),
             "{text}"
+        );
+    }
+
+    #[test]
+    fn settings_every_group_shares_are_printed_once() {
+        let rs = vec![
+            record("a_long_world_name", "x=1;s=1", 1, true),
+            record("a_long_world_name", "x=1;s=2", 1, false),
+        ];
+        let t = table(&rs);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(lines[0], "settings of every run: x=1", "{t}");
+        assert!(lines[1].starts_with("world             params "), "{t}");
+        // Rows name only their own setting, and the world column fits the long name.
+        assert!(lines[2].starts_with("a_long_world_name s=1 "), "{t}");
+        assert!(lines[3].starts_with("a_long_world_name s=2 "), "{t}");
+        assert!(
+            t.contains("a_long_world_name: s=1 vs s=2: 1 common seeds"),
+            "{t}"
+        );
+        // A lone group with settings: all of them above, none in its row.
+        let t = table(&rs[..1]);
+        assert!(t.starts_with("settings of every run: x=1; s=1\n"), "{t}");
+        assert!(t.contains("a_long_world_name (settings above) "), "{t}");
+        // No settings: no preamble, `(defaults)`.
+        let t = table(&[record("w", "", 1, true)]);
+        assert!(
+            t.starts_with("world ") && t.contains("\nw            (defaults) "),
+            "{t}"
         );
     }
 
