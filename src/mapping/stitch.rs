@@ -57,9 +57,10 @@
 //! members' strength: a weak loop in each of two windows is an obstacle both missed
 //! alone. A group one map saw is a hole when it is a robust hole and no neighbouring
 //! window covers its place ([`COVER`]: the obstacles at the arena's ends, or beyond the
-//! next domain), or when it is strong ([`crate::mapping::classify::Classifier::strong`]).
-//! A robust but not strong hole at a place the neighbour covers, where the neighbour's
-//! map holds encounters all round and no loop, is taken for noise of the one window.
+//! next domain, or cut by its edge), or when it is strong
+//! ([`crate::mapping::classify::Classifier::strong`]). A robust but not strong hole at a
+//! place the neighbour covers, where the neighbour's map holds encounters all round
+//! ([`COVER_SECTORS`]) and no loop, is taken for noise of the one window.
 //! The two observations are largely independent: the two windows embed their
 //! encounters separately and share only the encounters of their time overlap.
 //!
@@ -389,6 +390,12 @@ pub const SAME_VOID: f64 = 12.0;
 /// per cent (step 32).
 pub const COVER: f64 = 0.01;
 
+/// ... and when those events lie all round the place: in every one of this many equal
+/// angular sectors about it. A place at the edge of the neighbour's domain (an obstacle
+/// the neighbour's band cuts) has the neighbour's events on one side only, and the
+/// neighbour could not have seen a loop there.
+pub const COVER_SECTORS: usize = 8;
+
 /// One loop of a local map that the global map weighs: a robust hole or a candidate
 /// ([`crate::mapping::local::Component::mark`] indexing).
 #[derive(Debug, Clone, Copy)]
@@ -436,7 +443,8 @@ fn void_centre(map: &LocalMap, hole: &Hole) -> Option<[f64; 2]> {
 /// - two maps saw it (their marks are two observations of one place: robust or candidate,
 ///   each is evidence), or
 /// - one map saw it as a robust hole and no neighbouring map covers its place
-///   ([`COVER`]: an obstacle at the arena's end, or outside the other domains), or
+///   ([`COVER`], [`COVER_SECTORS`]: an obstacle at the arena's end, outside the other
+///   domains or cut by their edges), or
 /// - one map saw it as a strong hole ([`crate::mapping::classify::Classifier::strong`]) though a neighbour that
 ///   covers its place saw no loop there.
 ///
@@ -504,12 +512,20 @@ fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usi
             let comp = &nb.components[cj];
             let q = f.apply(at);
             let reach = SAME_VOID * comp.scale;
-            let near = comp
-                .events
-                .iter()
-                .filter(|&&e| (nb.points[e][0] - q[0]).hypot(nb.points[e][1] - q[1]) <= reach)
-                .count();
-            !comp.events.is_empty() && near as f64 >= COVER * comp.events.len() as f64
+            let mut near = 0;
+            let mut sectors = [false; COVER_SECTORS];
+            for &e in &comp.events {
+                let (dx, dy) = (nb.points[e][0] - q[0], nb.points[e][1] - q[1]);
+                if dx.hypot(dy) <= reach {
+                    near += 1;
+                    let turn = dy.atan2(dx) / std::f64::consts::TAU + 0.5;
+                    let s = ((turn * COVER_SECTORS as f64) as usize).min(COVER_SECTORS - 1);
+                    sectors[s] = true;
+                }
+            }
+            !comp.events.is_empty()
+                && near as f64 >= COVER * comp.events.len() as f64
+                && sectors.iter().all(|&s| s)
         })
     };
     let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
@@ -838,7 +854,7 @@ mod tests {
             death,
             weak[0],
         );
-        let second = planar_map_with(
+        let mut second = planar_map_with(
             2,
             (0..40).chain(50..60).collect(),
             lattice
@@ -851,6 +867,9 @@ mod tests {
             death,
             weak[1],
         );
+        // Its plane is M_1's scaled by 2, and so is its σ: [`SAME_VOID`] σ then reaches
+        // the ring round the origin, M_2's events all round that place.
+        second.components[0].scale = 0.2;
         (log(&times), first, second)
     }
 
@@ -869,6 +888,45 @@ mod tests {
         assert_eq!(g.holes, vec![(1, 0, 0)]);
         let (log, m1, m2) = two_maps([&[], &[]], [&round_origin_1, &[]], 2.0);
         assert_eq!(global_map(&[m1, m2], joins, &log).betti, [1, 0]);
+    }
+
+    /// A place at the edge of the neighbour's cloud is not covered: the neighbour holds
+    /// events on one side of it only (an obstacle its domain cuts), so it could not have
+    /// seen a loop there, and a robust hole of the other map stands on its own. The same
+    /// place with the neighbour's events all round it is covered.
+    #[test]
+    fn a_neighbour_with_events_on_one_side_only_does_not_cover() {
+        let join = one_join();
+        let joins = std::slice::from_ref(&join);
+        // M_1: the lattice (x −6..8) and a ring round (9, 0), just beyond its right edge,
+        // held as a robust hole that is not strong; M_2: the lattice only, on M_1's plane.
+        let times: Vec<f64> = (0..60).map(|k| 1000.0 + 10.0 * k as f64).collect();
+        let log = log(&times);
+        let weak_life = 1.0 + 0.4;
+        let first = planar_map_with(
+            1,
+            (0..50).collect(),
+            lattice().into_iter().chain(ring([9.0, 0.0], 1.0)).collect(),
+            &[(40..50).collect()],
+            weak_life,
+            &[],
+        );
+        // [`SAME_VOID`] σ = 1.2: the lattice point (8, 0) is the one event of M_2 near the
+        // place, on its −x side.
+        let second = planar_map_with(2, (0..40).collect(), lattice(), &[], 1.0, &[]);
+        let g = global_map(&[first.clone(), second], joins, &log);
+        assert_eq!(g.betti, [1, 1], "one-sided events do not cover");
+        // M_2 with events all round (9, 0) (its own copy of the ring's events): covered,
+        // and the weak hole M_2 does not see is dropped.
+        let all_round = planar_map_with(
+            2,
+            (0..50).collect(),
+            lattice().into_iter().chain(ring([9.0, 0.0], 1.0)).collect(),
+            &[],
+            1.0,
+            &[],
+        );
+        assert_eq!(global_map(&[first, all_round], joins, &log).betti, [1, 0]);
     }
 
     /// A robust hole that the next window covers (its lattice lies round the place) but
