@@ -391,9 +391,11 @@ pub const SAME_VOID: f64 = 12.0;
 pub const COVER: f64 = 0.01;
 
 /// ... and when those events lie all round the place: in every one of this many equal
-/// angular sectors about it. A place at the edge of the neighbour's domain (an obstacle
-/// the neighbour's band cuts) has the neighbour's events on one side only, and the
-/// neighbour could not have seen a loop there.
+/// angular sectors about it (an event exactly at the place has no direction and fills
+/// none). A place at the edge of the neighbour's domain (an obstacle the neighbour's band
+/// cuts) has the neighbour's events on one side only, and the neighbour could not have seen
+/// a loop there. So has a place within [`SAME_VOID`] σ of the arena's top or bottom side:
+/// a loop there that one window alone holds is judged by that window's test alone.
 pub const COVER_SECTORS: usize = 8;
 
 /// One loop of a local map that the global map weighs: a robust hole or a candidate
@@ -516,8 +518,12 @@ fn global_holes(maps: &[LocalMap], log: &EncounterLog) -> Vec<(usize, usize, usi
             let mut sectors = [false; COVER_SECTORS];
             for &e in &comp.events {
                 let (dx, dy) = (nb.points[e][0] - q[0], nb.points[e][1] - q[1]);
-                if dx.hypot(dy) <= reach {
+                let d = dx.hypot(dy);
+                if d <= reach {
                     near += 1;
+                    if d == 0.0 {
+                        continue;
+                    }
                     let turn = dy.atan2(dx) / std::f64::consts::TAU + 0.5;
                     let s = ((turn * COVER_SECTORS as f64) as usize).min(COVER_SECTORS - 1);
                     sectors[s] = true;
