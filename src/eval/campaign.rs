@@ -585,25 +585,25 @@ const MAX_PAIRS: usize = 15;
 pub fn confidence(groups: &[Group]) -> String {
     use crate::eval::stats::{Z95, mcnemar_exact, wilson};
     let mut out = String::new();
-    let with_truth: Vec<&Group> = groups.iter().filter(|g| g.global_runs > 0).collect();
+    let labels = Labels::of(groups);
+    // Each group with a global truth, with its table label.
+    let with_truth: Vec<(&Group, &str)> = groups
+        .iter()
+        .zip(&labels.params)
+        .filter(|(g, _)| g.global_runs > 0)
+        .map(|(g, l)| (g, l.as_str()))
+        .collect();
     if with_truth.is_empty() {
         return out;
     }
-    let labels = Labels::of(groups);
-    let label = |g: &Group| -> &str {
-        groups
-            .iter()
-            .position(|x| std::ptr::eq(x, g))
-            .map_or("", |i| labels.params[i].as_str())
-    };
     let (ww, pw) = (labels.world_width, labels.params_width);
     out.push_str("global ok over independent runs (failed runs left out), 95% Wilson interval:\n");
-    for g in &with_truth {
+    for &(g, label) in &with_truth {
         let (lo, hi) = wilson(g.global_ok, g.global_runs, Z95).unwrap_or((0.0, 1.0));
         out.push_str(&format!(
             "  {:<ww$} {:<pw$} {:>4} of {:<4} {:>6}  [{:.1}%, {:.1}%]\n",
             g.world,
-            label(g),
+            label,
             g.global_ok,
             g.global_runs,
             pct(g.global_ok, g.global_runs),
@@ -611,9 +611,12 @@ pub fn confidence(groups: &[Group]) -> String {
             100.0 * hi
         ));
     }
-    let mut by_world: BTreeMap<&str, Vec<&Group>> = BTreeMap::new();
-    for g in &with_truth {
-        by_world.entry(g.world.as_str()).or_default().push(g);
+    let mut by_world: BTreeMap<&str, Vec<(&Group, &str)>> = BTreeMap::new();
+    for &(g, label) in &with_truth {
+        by_world
+            .entry(g.world.as_str())
+            .or_default()
+            .push((g, label));
     }
     let mut lines = String::new();
     for (world, gs) in by_world.iter().filter(|(_, gs)| gs.len() > 1) {
@@ -629,7 +632,7 @@ pub fn confidence(groups: &[Group]) -> String {
                 if !all && i > 0 {
                     continue;
                 }
-                let (a, b) = (gs[i], gs[j]);
+                let ((a, label_a), (b, label_b)) = (gs[i], gs[j]);
                 let (mut common, mut only_a, mut only_b) = (0, 0, 0);
                 for (seed, ok_a) in &a.global_by_seed {
                     if let Some(ok_b) = b.global_by_seed.get(seed) {
@@ -640,8 +643,7 @@ pub fn confidence(groups: &[Group]) -> String {
                 }
                 lines.push_str(&format!(
                     "  {world}: {} vs {}: {common} common seeds",
-                    label(a),
-                    label(b),
+                    label_a, label_b,
                 ));
                 if common > 0 {
                     lines.push_str(&format!(
