@@ -9,7 +9,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Duration;
-use swarmmap::pipeline::{RunOptions, run_world};
+use swarmmap::pipeline::{Alongside, RunOptions, run_world};
 use swarmmap::world::WorldSpec;
 
 fn bench(c: &mut Criterion) {
@@ -21,8 +21,8 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(180));
     for (name, alongside) in [
-        ("scenario2_seed1_alongside", true),
-        ("scenario2_seed1_after", false),
+        ("scenario2_seed1_alongside", Alongside::Free),
+        ("scenario2_seed1_after", Alongside::Off),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {

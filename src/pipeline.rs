@@ -329,11 +329,28 @@ pub struct RunOptions<'a> {
     pub out: Option<PathBuf>,
     pub trajectories: Option<f64>,
     pub progress: Option<&'a dyn Fn(f64)>,
-    /// Map each window on the other cores while the simulation goes on, as soon as its
-    /// part of the log is final ([`run_world`]); the outputs are the same either way.
-    /// Worth it for one run on a machine with idle cores; `swarmmap eval`, which runs
-    /// many simulations side by side, leaves it off.
-    pub alongside: bool,
+    /// Whether to map windows on the other cores while the simulation goes on
+    /// ([`run_world`]); the outputs are the same in every mode.
+    pub alongside: Alongside,
+}
+
+/// How [`run_world`] maps while the simulation runs ("Mapping while the simulation runs").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Alongside {
+    /// Simulate, then map every window from the final log. `swarmmap eval`, which runs
+    /// many simulations side by side, and `swarmmap run --map-after` use this.
+    Off,
+    /// Map each window on the other cores as soon as its part of the log is final; the
+    /// simulation never waits, so a prefix that comes while another still waits for the
+    /// worker is left to the final pass. Worth it for one run on a machine with idle
+    /// cores: `swarmmap run` uses this.
+    Free,
+    /// As [`Alongside::Free`], but the simulation waits at each cut until the worker has
+    /// taken the prefix, so the worker maps every window whose prefix is handed out
+    /// (except perhaps the last one, which the simulation's end may overtake). Which
+    /// windows the worker maps then depends on the run alone, not on the machine's load:
+    /// for tests and for measuring the worker.
+    Lockstep,
 }
 
 /// Most windows for which [`run_world`] maps alongside the simulation: each prefix handed
@@ -345,8 +362,8 @@ pub const ALONGSIDE_MAX_WINDOWS: usize = 64;
 ///
 /// # Mapping while the simulation runs
 ///
-/// The simulation is one thread; with [`RunOptions::alongside`] (and more than one core)
-/// a second thread maps while it runs. The simulator hands out the log's prefix at the
+/// The simulation is one thread; with [`RunOptions::alongside`] other than
+/// [`Alongside::Off`] (and more than one core) a second thread maps while it runs. The simulator hands out the log's prefix at the
 /// end `c` of each window as soon as every encounter that started by `c` has ended
 /// ([`SimOptions::with_prefixes`]; one at a time: a prefix that comes while another still
 /// waits for the worker is not copied, and its window is left to the final pass, and with
@@ -392,14 +409,15 @@ pub fn run_world(
     let windows = cfg.windows();
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let alongside_pays = (2..=ALONGSIDE_MAX_WINDOWS).contains(&windows.len());
-    let (out, done, alongside) = if opts.alongside && cores > 1 && alongside_pays {
+    let on = opts.alongside != Alongside::Off;
+    let (out, done, alongside) = if on && cores > 1 && alongside_pays {
         simulate_alongside(
             world,
             sim_opts,
             &cfg,
             &stitch,
             &windows,
-            cores - 1,
+            (cores - 1, opts.alongside == Alongside::Lockstep),
             &mut timings,
         )?
     } else {
@@ -427,15 +445,17 @@ pub fn run_world(
 }
 
 /// Runs the simulation on this thread while a worker with a pool of `threads` threads
-/// maps each window's prefix ([`run_world`], "Mapping while the simulation runs").
-/// Returns the simulation, what the worker finished, and the worker's busy time per stage.
+/// maps each window's prefix ([`run_world`], "Mapping while the simulation runs");
+/// with `lockstep` ([`Alongside::Lockstep`]) the simulation waits at each cut until the
+/// worker has taken the prefix. Returns the simulation, what the worker finished, and
+/// the worker's busy time per stage.
 fn simulate_alongside(
     world: &World,
     sim_opts: SimOptions<'_>,
     cfg: &MapConfig,
     stitch: &StitchParams,
     windows: &[Window],
-    threads: usize,
+    (threads, lockstep): (usize, bool),
     timings: &mut Timings,
 ) -> Result<(SimOutput, Partial, Timings), PipelineError> {
     let cuts: Vec<f64> = windows.iter().map(|w| w.end).collect();
@@ -443,7 +463,11 @@ fn simulate_alongside(
         stop: false,
         taken: vec![false; windows.len()],
     });
-    let (tx, rx) = mpsc::channel::<(usize, EncounterLog)>();
+    // Without lockstep a send never blocks: it is made only when nothing waits. With it,
+    // a send returns once the worker has received the prefix, and the worker claims each
+    // prefix before it receives the next, so every prefix but the last handed out is
+    // claimed before the simulation can end (a worker that has stopped makes the send fail).
+    let (tx, rx) = mpsc::sync_channel::<(usize, EncounterLog)>(usize::from(!lockstep));
     let waiting = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         let (claims, waiting) = (&claims, &waiting);
@@ -458,7 +482,7 @@ fn simulate_alongside(
         // to the final pass, so the copies stay few and memory stays bounded however many
         // windows there are.
         let hand_out = |k: usize, build: &dyn Fn() -> EncounterLog| {
-            if waiting.load(Ordering::Acquire) == 0 {
+            if lockstep || waiting.load(Ordering::Acquire) == 0 {
                 waiting.fetch_add(1, Ordering::AcqRel);
                 // The worker only stops receiving once the simulation has ended.
                 let _ = tx.send((k, build()));

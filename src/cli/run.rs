@@ -4,7 +4,7 @@
 use super::{Failure, input, load_world, progress_bar};
 use clap::Args;
 use std::path::PathBuf;
-use swarmmap::pipeline::{RunOptions, run_world};
+use swarmmap::pipeline::{Alongside, RunOptions, run_world};
 
 /// Options of `swarmmap run`.
 #[derive(Args, Debug)]
@@ -57,7 +57,11 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
                 .unwrap_or_else(|| swarmmap::report::default_trajectory_interval(&world)),
         ),
         progress: Some(&report),
-        alongside: !args.map_after,
+        alongside: if args.map_after {
+            Alongside::Off
+        } else {
+            Alongside::Free
+        },
     };
     let result = run_world(&world, &opts);
     if let Some(b) = &bar {

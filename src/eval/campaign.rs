@@ -11,7 +11,7 @@
 
 use crate::io::write_atomic;
 use crate::mapping::output::Summary;
-use crate::pipeline::{RunOptions, run_world};
+use crate::pipeline::{Alongside, RunOptions, run_world};
 use crate::world::{WorldSpec, apply_override};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -125,7 +125,7 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
             out: None,
             trajectories: None,
             progress: None,
-            alongside: false,
+            alongside: Alongside::Off,
         };
         let (_, mapped) = run_world(&world, &opts).map_err(|e| e.to_string())?;
         Ok(mapped.summary)
