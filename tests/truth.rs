@@ -470,11 +470,12 @@ fn random_separated_discs() {
     }
 }
 
-/// The brief's speed target: a 30 m × 10 m arena at 1 cm (3 M cells) builds well under a
-/// second and answers a 3 m band in milliseconds. Bounds are loose (shared 2-core machine,
-/// also run in debug builds); the measured figures are printed.
+/// A paper-sized arena (30 m × 10 m at 1 cm, 3 M cells) has the truth its four obstacles
+/// give, and every 3 m band of it one component at least. (Its speed, the brief's target of
+/// well under a second to build and milliseconds a band, is measured by `cargo bench
+/// --bench truth`, not here.)
 #[test]
-fn paper_sized_arena_is_fast() {
+fn paper_sized_arena_has_its_truth() {
     let mut w = World::empty("scenario-like", 30.0, 10.0);
     w.obstacles = vec![
         rect(6.0, 2.0, 8.0, 4.0),
@@ -482,22 +483,12 @@ fn paper_sized_arena_is_fast() {
         rect(11.0, 4.0, 22.0, 6.0),
         disc(25.0, 5.0, 1.0),
     ];
-    let t = std::time::Instant::now();
     let fs = FreeSpace::new(&w, 0.01).unwrap();
-    let build = t.elapsed().as_secs_f64();
     assert_eq!(fs.global_betti(), [1, 4]);
-    let t = std::time::Instant::now();
-    let mut total = 0;
     for k in 0..27 {
-        let x0 = k as f64;
-        total += fs.betti_in_band(x0, x0 + 3.0)[0];
+        let x0 = f64::from(k);
+        assert!(fs.betti_in_band(x0, x0 + 3.0)[0] >= 1, "band at {x0}");
     }
-    let query = t.elapsed().as_secs_f64() / 27.0;
-    assert!(total >= 27);
-    println!("30 m x 10 m at 1 cm: build {build:.3} s, 3 m band query {query:.4} s");
-    let slack = if cfg!(debug_assertions) { 20.0 } else { 1.0 };
-    assert!(build < 3.0 * slack, "build took {build} s");
-    assert!(query < 0.1 * slack, "band query took {query} s");
 }
 
 /// A U-shaped obstacle (outer x 4–6 m, y 1.5–3.5 m, arms 0.3 m thick) whose pocket opens
