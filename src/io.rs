@@ -145,3 +145,91 @@ mod tests {
         assert_eq!(fs::read(&atomic).unwrap(), b"c,d\n");
     }
 }
+
+/// Removes the files of `dir` that an earlier run wrote and this one did not: those whose
+/// name `ours` recognises as swarmmap's per-window or per-connection outputs and that are
+/// not in `written`. Mapping a log again with fewer windows (`swarmmap map --windows`)
+/// would otherwise leave the old windows' files beside the new ones, to be read as theirs.
+/// Nothing else is touched; a missing `dir` is nothing to do.
+pub fn remove_stale(
+    dir: &Path,
+    written: &std::collections::BTreeSet<String>,
+    ours: impl Fn(&str) -> bool,
+) -> io::Result<()> {
+    let entries = match fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e),
+    };
+    for entry in entries {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().to_string();
+        if ours(&name) && !written.contains(&name) && entry.file_type()?.is_file() {
+            fs::remove_file(entry.path())?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether `name` is `{prefix}_{N}{rest}` for some `prefix` of `prefixes`, a number `N`
+/// and a `rest` that `tail` accepts: the shape of swarmmap's per-window and per-connection
+/// files, for [`remove_stale`].
+pub fn numbered(name: &str, prefixes: &[&str], tail: impl Fn(&str) -> bool) -> bool {
+    prefixes.iter().any(|p| {
+        name.strip_prefix(p)
+            .and_then(|r| r.strip_prefix('_'))
+            .is_some_and(|r| {
+                let digits = r.chars().take_while(char::is_ascii_digit).count();
+                digits > 0 && tail(&r[digits..])
+            })
+    })
+}
+
+#[cfg(test)]
+mod stale_tests {
+    use super::*;
+    use std::collections::BTreeSet;
+
+    #[test]
+    fn only_unwritten_numbered_outputs_are_removed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let names = [
+            "window_1.json",
+            "window_2.json",
+            "window_12.json",
+            "connection_3.json",
+            "connections.json",
+            "global.json",
+            "window_x.json",
+            "notes.txt",
+        ];
+        for n in names {
+            fs::write(tmp.path().join(n), "x").unwrap();
+        }
+        let written: BTreeSet<String> = ["window_1.json", "connections.json"]
+            .into_iter()
+            .map(String::from)
+            .collect();
+        remove_stale(tmp.path(), &written, |n| {
+            numbered(n, &["window", "connection"], |r| r == ".json")
+        })
+        .unwrap();
+        let mut left: Vec<String> = fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            [
+                "connections.json",
+                "global.json",
+                "notes.txt",
+                "window_1.json",
+                "window_x.json"
+            ]
+        );
+        // A directory that does not exist is nothing to clean.
+        remove_stale(&tmp.path().join("none"), &written, |_| true).unwrap();
+    }
+}

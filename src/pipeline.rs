@@ -5,7 +5,7 @@
 //! disk; `swarmmap eval` calls [`run_world`] for many worlds and seeds in parallel.
 
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
-use crate::io::write_atomic;
+use crate::io::{numbered, remove_stale, write_atomic};
 use crate::log::{EncounterLog, LogError};
 use crate::mapping::local::LocalMap;
 use crate::mapping::local::local_map;
@@ -293,8 +293,12 @@ fn finish(
 /// per consecutive pair, named after its first window), `maps/global.json` and
 /// `summary.json` into `dir`, each atomically.
 pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), PipelineError> {
+    let written = std::cell::RefCell::new(std::collections::BTreeSet::new());
     let write = |name: String, text: String| {
-        let path = dir.join(name);
+        let path = dir.join(&name);
+        if let Some(file) = name.strip_prefix("maps/") {
+            written.borrow_mut().insert(file.to_string());
+        }
         write_atomic(&path, text.as_bytes()).map_err(|source| PipelineError::Write { path, source })
     };
     for (map, s) in m.maps.iter().zip(&m.summary.windows) {
@@ -312,6 +316,12 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     write("maps/connections.json".into(), to_json(&m.connections))?;
     write("maps/global.json".into(), to_json(&m.global))?;
     write("summary.json".into(), to_json(&m.summary))?;
+    // A log mapped before with more windows left files these maps do not replace.
+    let maps = dir.join("maps");
+    remove_stale(&maps, &written.borrow(), |n| {
+        numbered(n, &["window", "connection"], |rest| rest == ".json")
+    })
+    .map_err(|source| PipelineError::Write { path: maps, source })?;
     Ok(())
 }
 

@@ -1434,10 +1434,14 @@ fn a_tall_arena_is_checked_without_a_panic() {
 
 /// Regression, the same cause short of a panic: an arena of aspect ratio r > 4e6 got
 /// about `sqrt(4e6 · r)` cells, beyond the documented four million (a 30 m × 1e9 m arena
-/// 11.5 million; 1e20 m aborted the process when the allocation failed).
+/// 11.5 million; 1e20 m aborted the process when the allocation failed). The world check
+/// now refuses sides over 10 km, but a `World` built in code reaches the raster unchecked.
 #[test]
 fn free_space_raster_is_bounded_for_an_elongated_arena() {
-    let world = World::from_str_named(&empty_world_with_height("1e9"), ORIGIN).expect("valid");
+    let err = World::from_str_named(&empty_world_with_height("1e9"), ORIGIN).unwrap_err();
+    assert!(err.to_string().contains("more than 10000 m"), "{err}");
+    let mut world = World::from_str_named(CHECKED_WORLDS[0].1, ORIGIN).expect("valid");
+    world.arena.height = 1e9;
     let raster = FreeSpaceRaster::new(&world, world.swarm.body_radius);
     let cells = raster.nx * raster.ny;
     assert!(

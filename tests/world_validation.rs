@@ -308,8 +308,8 @@ fn agents_must_not_be_zero() {
 /// 200-digit number.
 #[test]
 fn an_overlong_run_names_its_duration_compactly() {
-    let e = error_of("(arena: (width: 1e200, height: 10.0))");
-    assert_has(&e, &["the 2.000e202 s run needs 6.667e203 steps"]);
+    let e = error_of("(leader: (speed: 1e-200))");
+    assert_has(&e, &["the 2.700e201 s run needs 9.000e202 steps"]);
     assert!(!e.contains("00000000000"), "{e}");
 }
 

@@ -19,8 +19,8 @@ pub struct EvalArgs {
     /// Seeds: `A..B` (inclusive), or a comma-separated list.
     #[arg(long, default_value = "1..20")]
     pub seeds: String,
-    /// Runs in parallel (default: the number of cores).
-    #[arg(long)]
+    /// Runs in parallel (default: the number of cores; at most 1024).
+    #[arg(long, value_parser = super::thread_count)]
     pub jobs: Option<usize>,
     /// Sweep a world field over values, e.g. `--set swarm.detection_radius=0.01,0.03,0.1`
     /// (repeatable; every combination is run).

@@ -108,6 +108,24 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
         cfg.overlap = o;
     }
+    let length = (cfg.span.1 - cfg.span.0) / cfg.windows as f64;
+    if cfg.overlap >= length {
+        let whose = match (args.overlap, &world) {
+            (Some(_), _) => "--overlap".to_string(),
+            (None, Some(_)) => "the world's mapping.overlap".to_string(),
+            (None, None) => "the default overlap".to_string(),
+        };
+        return Err(input(anyhow::anyhow!(
+            "{whose} is {} s, not shorter than one window ({} s = {} s of log / {} windows), \
+             so every window would span the whole log; pass --overlap below {} s, or fewer \
+             --windows",
+            cfg.overlap,
+            (length * 1e3).round() / 1e3,
+            ((cfg.span.1 - cfg.span.0) * 1e3).round() / 1e3,
+            cfg.windows,
+            (length * 1e3).round() / 1e3,
+        )));
+    }
     if let Some(method) = args.method {
         let mut m = world
             .as_ref()

@@ -47,6 +47,25 @@ pub fn load_world(
 }
 
 /// A progress bar on stderr when it is a terminal and `quiet` is off.
+/// Most worker threads a command takes (`--jobs`, `--threads`): far beyond any machine's
+/// cores, and a bound on the stacks a typo would otherwise ask for.
+pub const MAX_THREADS: usize = 1024;
+
+/// Parses a thread count for clap: 0 to [`MAX_THREADS`].
+pub fn thread_count(text: &str) -> Result<usize, String> {
+    let n: usize = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a whole number"))?;
+    if n > MAX_THREADS {
+        return Err(format!(
+            "{n} threads is too many; use at most {MAX_THREADS} (the machine has {} cores)",
+            std::thread::available_parallelism().map_or(1, usize::from)
+        ));
+    }
+    Ok(n)
+}
+
 pub fn progress_bar(quiet: bool, label: &str) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     (!quiet && std::io::stderr().is_terminal()).then(|| {
@@ -115,14 +134,31 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", describe(&e));
             ExitCode::from(2)
         }
         Err(Failure::Other(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", describe(&e));
             ExitCode::from(1)
         }
     }
+}
+
+/// An error and its causes, `: `-separated as anyhow's `{:#}` writes them, but without a
+/// cause that the message before it already quotes (our errors name their source in their
+/// own text, as "cannot write X: <the OS error>").
+fn describe(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.is_empty() {
+            text = part;
+        } else if !text.contains(&part) {
+            text.push_str(": ");
+            text.push_str(&part);
+        }
+    }
+    text
 }
 
 /// `--model FILE`: every later mapping in this process judges with FILE's models; a bad file

@@ -39,8 +39,8 @@ pub struct PersistenceArgs {
     /// column with the triangle that kills it.
     #[arg(long)]
     pub cycles: bool,
-    /// Worker threads; 0 uses all cores.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads; 0 uses all cores (at most 1024).
+    #[arg(long, default_value_t = 0, value_parser = super::thread_count)]
     pub threads: usize,
 }
 

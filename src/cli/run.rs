@@ -42,7 +42,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("runs/{}-seed{seed}", world.name)));
+        .unwrap_or_else(|| PathBuf::from(format!("runs/{}-seed{seed}", file_safe(&world.name))));
     let bar = progress_bar(args.quiet, "simulating");
     let report = |f: f64| {
         if let Some(b) = &bar {
@@ -81,4 +81,39 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         println!("{}", super::report::describe(&written));
     }
     Ok(())
+}
+
+/// `name` as one path component: characters other than letters, digits, `-`, `_` and `.`
+/// become `_`, and a leading `.` too, so a world's name (free text) cannot reach outside
+/// `runs/` (`../x`, `/etc/x`) or hide the directory.
+fn file_safe(name: &str) -> String {
+    let mut out: String = name
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if out.starts_with('.') {
+        out.replace_range(..1, "_");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::file_safe;
+
+    #[test]
+    fn world_names_become_one_safe_path_component() {
+        assert_eq!(file_safe("scenario2"), "scenario2");
+        assert_eq!(file_safe("my world (v2)"), "my_world__v2_");
+        assert_eq!(file_safe("../../esc"), "_._.._esc");
+        assert_eq!(file_safe("/etc/x"), "_etc_x");
+        assert_eq!(file_safe(".hidden"), "_hidden");
+        assert_eq!(file_safe("café"), "café");
+    }
 }

@@ -174,7 +174,7 @@ pub fn run_campaign(
     }
     let models = models_part();
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
+        .num_threads(threads.clamp(1, jobs.len().max(1)))
         .build()
         .map_err(std::io::Error::other)?;
     let records: Vec<std::io::Result<RunRecord>> = pool.install(|| {

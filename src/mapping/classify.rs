@@ -351,17 +351,17 @@ impl Models {
             }
             for m in &bank.0 {
                 let c = m.classifier;
-                let ok = c.h0_ratio.is_finite()
-                    && c.h0_ratio > 0.0
-                    && c.h1_ratio.is_finite()
+                let ok = c.h0_ratio > 0.0
+                    && c.h0_ratio <= MAX_THRESHOLD
                     && c.h1_ratio >= 1.0
-                    && c.h1_span.is_finite()
-                    && c.h1_span >= 0.0;
+                    && c.h1_ratio <= MAX_THRESHOLD
+                    && c.h1_span >= 0.0
+                    && c.h1_span <= MAX_THRESHOLD;
                 if !ok {
                     anyhow::bail!(
-                        "{}: the {name} model's thresholds (h0_ratio {}, h1_ratio {}, h1_span {}) \
+                        "{}: the {name} model's thresholds (h0_ratio {:?}, h1_ratio {:?}, h1_span {:?}) \
                          are out of range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, \
-                         all finite",
+                         all at most 1e12 (fitted models stay below 100)",
                         path.display(),
                         c.h0_ratio,
                         c.h1_ratio,
@@ -379,12 +379,12 @@ impl Models {
                     );
                 }
                 if let Some(x) = c.h1_stability
-                    && !(x.is_finite() && x >= 0.0)
+                    && !(0.0..=MAX_THRESHOLD).contains(&x)
                 {
                     anyhow::bail!(
                         "{}: the {name} model's h1_stability is {x}; it is the least life, in \
-                         σ, that both halves of a window must give a hole, a finite number ≥ 0 \
-                         (or leave it out for no stability test)",
+                         σ, that both halves of a window must give a hole, a number from 0 to \
+                         1e12 (or leave it out for no stability test)",
                         path.display()
                     );
                 }
@@ -491,6 +491,11 @@ pub fn sampling_scale(features: &[Feature]) -> f64 {
     d.sort_by(f64::total_cmp);
     d[d.len() / 2]
 }
+
+/// Largest threshold a model file may hold (ratios, and lives in σ): fitted ones stay
+/// below 100, and 1e9 already makes every feature noise (the tests' way of asking for
+/// no hole); near `f64::MAX` the report's axes never finished.
+pub const MAX_THRESHOLD: f64 = 1e12;
 
 /// The candidate test's share of the H1 thresholds: a loop with `death / birth ≥ 0.85 ·
 /// h1_ratio` and `death − birth ≥ 0.75 · h1_span · σ` is a candidate, a hole that counts in
@@ -838,6 +843,29 @@ mod tests {
             .to_string();
         assert!(err.contains("h1_stability is -1"), "{err}");
         m.embedded.0[0].classifier.h1_stability = Some(3.25);
+        assert_eq!(load_text(&serde_json::to_string(&m).unwrap()).unwrap(), m);
+    }
+
+    /// A threshold near `f64::MAX` made every feature noise and the report's figures
+    /// never finish their axes: refused, with the bound.
+    #[test]
+    fn a_huge_threshold_is_refused() {
+        for field in 0..4 {
+            let mut m = Models::shipped();
+            let c = &mut m.paper.0[0].classifier;
+            match field {
+                0 => c.h0_ratio = 1e308,
+                1 => c.h1_ratio = 1e13,
+                2 => c.h1_span = 1e308,
+                _ => c.h1_stability = Some(1e308),
+            }
+            let err = load_text(&serde_json::to_string(&m).unwrap())
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("1e12"), "{field}: {err}");
+        }
+        let mut m = Models::shipped();
+        m.paper.0[0].classifier.h1_span = MAX_THRESHOLD;
         assert_eq!(load_text(&serde_json::to_string(&m).unwrap()).unwrap(), m);
     }
 

@@ -142,6 +142,29 @@ fn chart<'a, 'b>(
     chart_with(area, title, x, y, (x_desc, y_desc), 6)
 }
 
+/// Largest magnitude an axis reaches: the figures' values are seconds, metres and
+/// multiples of σ, far below it, and plotters' tick search does not finish on ranges near
+/// `f64::MAX` (a hand-edited map or model can hold such values).
+const AXIS_LIMIT: f64 = 1e12;
+
+/// `range` clamped to ±[`AXIS_LIMIT`], ordered and non-degenerate.
+fn plottable((lo, hi): (f64, f64)) -> (f64, f64) {
+    let clamp = |v: f64| {
+        if v.is_nan() {
+            0.0
+        } else {
+            v.clamp(-AXIS_LIMIT, AXIS_LIMIT)
+        }
+    };
+    let (lo, hi) = (clamp(lo), clamp(hi));
+    let (lo, hi) = (lo.min(hi), lo.max(hi));
+    if hi - lo > 1e-9 * lo.abs().max(hi.abs()).max(1e-12) {
+        (lo, hi)
+    } else {
+        (lo - 1.0, hi + 1.0)
+    }
+}
+
 fn chart_with<'a, 'b>(
     area: &'a Area<'b>,
     title: &str,
@@ -150,6 +173,7 @@ fn chart_with<'a, 'b>(
     (x_desc, y_desc): (&str, &str),
     y_labels: usize,
 ) -> Result<Chart<'a, 'b>, Box<dyn std::error::Error>> {
+    let (x, y) = (plottable(x), plottable(y));
     let mut c = ChartBuilder::on(area)
         .caption(title, (FONT, 14))
         .margin(8)
@@ -1129,6 +1153,26 @@ pub fn all(run: &RunData) -> Result<Vec<Figure>, ReportError> {
 mod tests {
     use super::*;
     use crate::report::data::MergeIn;
+
+    /// Axis ranges from hand-edited maps (a scale or threshold near `f64::MAX`, NaN,
+    /// reversed or empty) become finite, ordered and non-empty; plotters' tick search did
+    /// not finish on the huge ones.
+    #[test]
+    fn axis_ranges_are_made_plottable() {
+        assert_eq!(plottable((0.0, 10.0)), (0.0, 10.0));
+        assert_eq!(plottable((0.0, 1e308)), (0.0, AXIS_LIMIT));
+        assert_eq!(plottable((f64::NEG_INFINITY, f64::NAN)), (-AXIS_LIMIT, 0.0));
+        assert_eq!(plottable((3.0, 1.0)), (1.0, 3.0));
+        assert_eq!(plottable((2.0, 2.0)), (1.0, 3.0));
+        assert_eq!(plottable((f64::NAN, f64::NAN)), (-1.0, 1.0));
+        // Drawn, a huge range takes no longer than any other.
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (200, 150)).into_drawing_area();
+            chart(&root, "t", (0.0, 1e308), (-1e308, 1e308), "x", "y").unwrap();
+        }
+        assert!(svg.contains("<svg"));
+    }
 
     #[test]
     fn compact_drops_defaults_and_repeated_circles_only() {

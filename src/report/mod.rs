@@ -119,6 +119,18 @@ pub fn write_report(dir: &Path) -> Result<Written, ReportError> {
     }
     let index = out.join("index.html");
     write(index.clone(), report.html.as_bytes())?;
+    // Figures of windows and connections an earlier mapping had and this one has not.
+    let names: std::collections::BTreeSet<String> =
+        report.figures.iter().map(|f| f.name.clone()).collect();
+    crate::io::remove_stale(&out, &names, |n| {
+        crate::io::numbered(n, &["window", "connection"], |rest| {
+            rest.starts_with('_') && rest.ends_with(".svg")
+        })
+    })
+    .map_err(|source| ReportError::Write {
+        path: out.clone(),
+        source,
+    })?;
     Ok(Written {
         index,
         bytes: report.html.len(),

@@ -225,11 +225,50 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
     write_atomic(&path, bytes).map_err(|source| SimError::Write { path, source })
 }
 
+/// Removes what an earlier run in `dir` derived from its log, before a new log replaces it:
+/// `summary.json`, the maps (`maps/`: each window's and connection's file,
+/// `connections.json`, `global.json`), the report (`report/`: `index.html` and its
+/// figures) and, when this run records none, `trajectories.csv`. Left in place they would
+/// be read as the new log's (a report pairing the new maps with the old replay). Only
+/// those files of swarmmap's are removed; anything else in `dir` stays.
+fn remove_derived(dir: &Path, trajectories: bool) -> std::io::Result<()> {
+    use crate::io::{numbered, remove_stale};
+    let none = std::collections::BTreeSet::new();
+    let mut files = vec!["summary.json"];
+    if trajectories {
+        files.push("trajectories.csv");
+    }
+    remove_stale(dir, &none, |n| files.contains(&n))?;
+    remove_stale(&dir.join("maps"), &none, |n| {
+        n == "connections.json"
+            || n == "global.json"
+            || numbered(n, &["window", "connection"], |rest| rest == ".json")
+    })?;
+    remove_stale(&dir.join("report"), &none, |n| {
+        matches!(n, "index.html" | "environment.svg" | "global.svg")
+            || numbered(n, &["window", "connection"], |rest| {
+                rest.starts_with('_') && rest.ends_with(".svg")
+            })
+    })
+}
+
 /// Writes the run's files into `dir` (created if missing), each atomically:
 /// `encounters.csv`, `static_intervals.csv`, `leader.csv`, `meta.json`, and
 /// `trajectories.csv` when trajectories were recorded.
 pub fn write_run(dir: &Path, world: &World, out: &SimOutput) -> Result<(), SimError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(SimError::Write {
+            path: dir.to_path_buf(),
+            source: std::io::Error::other(
+                "it is a file, not a directory; give --out a new or existing directory",
+            ),
+        });
+    }
     std::fs::create_dir_all(dir).map_err(|source| SimError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    remove_derived(dir, out.trajectories.is_none()).map_err(|source| SimError::Write {
         path: dir.to_path_buf(),
         source,
     })?;

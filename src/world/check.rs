@@ -20,6 +20,10 @@ use super::types::*;
 
 /// Largest number of agents accepted (memory for the simulation stays modest).
 pub const MAX_AGENTS: usize = 1_000_000;
+
+/// Longest side of an arena, metres: Rapier works in `f32`, whose spacing at 10 km is
+/// about 1 mm, a tenth of the bundled worlds' detection radius.
+pub const MAX_ARENA_SIDE: f64 = 10_000.0;
 /// Largest number of time steps in one run (dispersion plus sweep over `dt`).
 pub const MAX_STEPS: f64 = 1e9;
 /// Largest number of windows.
@@ -66,7 +70,11 @@ impl Ctx<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err(field, format!("is {v} (must be a finite number)"), fix))
+            Err(self.err(
+                field,
+                format!("is {} (must be a finite number)", short(v)),
+                fix,
+            ))
         }
     }
 
@@ -80,7 +88,7 @@ impl Ctx<'_> {
             } else {
                 format!(" {unit}")
             };
-            Err(self.err(field, format!("is {v} (must be > 0{unit})"), fix))
+            Err(self.err(field, format!("is {} (must be > 0{unit})", short(v)), fix))
         }
     }
 
@@ -89,7 +97,7 @@ impl Ctx<'_> {
         if v >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err(field, format!("is {v} (must be ≥ 0 {unit})"), fix))
+            Err(self.err(field, format!("is {} (must be ≥ 0 {unit})", short(v)), fix))
         }
     }
 
@@ -287,6 +295,14 @@ fn short(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }
+    if !(1e-6..1e9).contains(&x.abs()) {
+        // Far from the metres and seconds of a world: mantissa and exponent, not hundreds
+        // of digits.
+        let s = format!("{x:.5e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        return format!("{m}e{e}");
+    }
     let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
     let s = format!("{x:.digits$}");
     if s.contains('.') {
@@ -353,6 +369,15 @@ impl WorldSpec {
                 "give the arena a positive height, e.g. 10.0",
             )?,
         };
+        for (field, v) in [("arena.width", arena.width), ("arena.height", arena.height)] {
+            if v > MAX_ARENA_SIDE {
+                return Err(ctx.err(
+                    field,
+                    format!("is {} m, more than {MAX_ARENA_SIDE} m: the physics engine works in single precision, which cannot place centimetre-sized agents that far from the origin", short(v)),
+                    "use an arena of at most 10 km a side (the paper's is 30 m × 10 m)",
+                ));
+            }
+        }
 
         // Obstacles.
         let obstacles = self
@@ -385,6 +410,18 @@ impl WorldSpec {
             "metres",
             "give a positive detection radius (the paper's r_d is 0.01)",
         )?;
+        let diagonal = arena.width.hypot(arena.height);
+        if detection_radius > diagonal {
+            return Err(ctx.err(
+                "swarm.detection_radius",
+                format!(
+                    "is {} m, more than the arena's diagonal ({} m): every pair of agents would be in contact all the time",
+                    short(detection_radius),
+                    short(diagonal)
+                ),
+                "use a detection radius well below the arena's size (the paper's r_d is 0.01 m)",
+            ));
+        }
         let landmark_fraction = ctx.finite(
             "swarm.landmark_fraction",
             s.landmark_fraction.unwrap_or(d.landmark_fraction),
@@ -768,6 +805,9 @@ mod tests {
         assert_eq!(short(28.5), "28.5");
         assert_eq!(short(0.0), "0");
         assert_eq!(short(1.0 / 3.0), "0.333333");
+        assert_eq!(short(1e300), "1e300");
+        assert_eq!(short(-2.5e39), "-2.5e39");
+        assert_eq!(short(1.234567e-9), "1.23457e-9");
     }
 
     #[test]

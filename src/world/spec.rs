@@ -250,6 +250,10 @@ fn explain(code: &ron::Error) -> String {
         }
         E::Eof => "unexpected end of the file; a closing bracket is probably missing".into(),
         E::ExpectedComma => "expected a comma here, between the previous entry and this one".into(),
+        E::IntegerOutOfBounds => "this whole number is out of range for its field (a count or \
+             a seed cannot be negative, and a seed is below 2^64; the README's World files \
+             section gives each field's range)"
+            .into(),
         other => format!("{other} (see the README's World files section for the format)"),
     }
 }
@@ -257,6 +261,8 @@ fn explain(code: &ron::Error) -> String {
 /// Parses RON `text` into a raw spec; `origin_name` (usually the file name) prefixes
 /// error positions: `worlds/x.ron:12:5: unknown field ...`.
 pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError> {
+    // A byte-order mark (some Windows editors write one) is not part of the RON text.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut spec: WorldSpec = ron_options()
         .from_str(text)
         .map_err(|e| WorldError::Syntax {

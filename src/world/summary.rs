@@ -13,9 +13,24 @@ impl WorldSpec {
     /// Reads and parses a world file (not yet checked; apply overrides, then `check`).
     pub fn load(path: impl AsRef<Path>) -> Result<WorldSpec, WorldError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| WorldError::Read {
+        let bytes = std::fs::read(path).map_err(|source| WorldError::Read {
             path: path.display().to_string(),
             source,
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            // Where the first byte that is not UTF-8 lies, as line:col.
+            let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let before = String::from_utf8_lossy(good);
+            let line = before.matches('\n').count() + 1;
+            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            WorldError::Syntax {
+                origin: path.display().to_string(),
+                line,
+                col,
+                message: "this byte is not UTF-8 text; save the world file as UTF-8 (it is \
+                          read as UTF-8 whatever the editor's default)"
+                    .into(),
+            }
         })?;
         parse_str(&text, &path.display().to_string())
     }

@@ -1,0 +1,232 @@
+//! Bad input found by an adversarial pass over the command line (thirty-third session):
+//! each case exits with an error that says what and how to fix, or, for outputs an earlier
+//! run left behind, removes them instead of mixing them with the new run's.
+
+use assert_cmd::Command;
+use predicates::prelude::PredicateBooleanExt;
+use predicates::str::contains;
+use std::fs;
+use std::path::Path;
+
+const TINY: &str = "tests/fixtures/worlds/tiny.ron";
+
+fn swarmmap() -> Command {
+    Command::cargo_bin("swarmmap").expect("binary built")
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn world_values_the_physics_cannot_represent_are_refused() {
+    swarmmap()
+        .args(["check", TINY, "--set", "arena.height=1e300"])
+        .assert()
+        .code(2)
+        .stderr(
+            contains("arena.height is 1e300 m, more than 10000 m").and(contains("at most 10 km")),
+        );
+    // A radius beyond the arena's diagonal overflowed Rapier's f32 and recorded nothing.
+    swarmmap()
+        .args(["check", TINY, "--set", "swarm.detection_radius=1e39"])
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "swarm.detection_radius is 1e39 m, more than the arena's diagonal",
+        ));
+}
+
+#[test]
+fn world_files_with_a_byte_order_mark_or_bytes_that_are_not_utf8() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = fs::read(TINY).unwrap();
+    let bom = tmp.path().join("bom.ron");
+    fs::write(&bom, [b"\xef\xbb\xbf".as_slice(), &text].concat()).unwrap();
+    swarmmap()
+        .args(["check"])
+        .arg(&bom)
+        .assert()
+        .success()
+        .stdout(contains("tiny"));
+    let latin1 = tmp.path().join("latin1.ron");
+    fs::write(&latin1, b"(\n  name: \"caf\xe9\",\n)").unwrap();
+    swarmmap()
+        .args(["check"])
+        .arg(&latin1)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "latin1.ron:2:13: this byte is not UTF-8 text; save the world file as UTF-8",
+        ));
+    let negative = tmp.path().join("neg.ron");
+    let t = String::from_utf8(text)
+        .unwrap()
+        .replace("seed: 3", "seed: -1");
+    fs::write(&negative, t).unwrap();
+    swarmmap()
+        .args(["check"])
+        .arg(&negative)
+        .assert()
+        .code(2)
+        .stderr(contains("this whole number is out of range for its field"));
+}
+
+#[test]
+fn thread_counts_are_bounded() {
+    swarmmap()
+        .args(["eval", TINY, "--seeds", "1..1", "--jobs", "10000"])
+        .assert()
+        .code(2)
+        .stderr(contains("10000 threads is too many; use at most 1024"));
+    swarmmap()
+        .args(["persistence", "points.csv", "--threads", "5000"])
+        .assert()
+        .code(2)
+        .stderr(contains("use at most 1024"));
+}
+
+#[test]
+fn a_model_threshold_near_the_largest_float_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut m: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string("assets/classifier.json").unwrap()).unwrap();
+    m["Paper"]["classifier"]["h1_span"] = serde_json::json!(1e308);
+    let path = tmp.path().join("m.json");
+    fs::write(&path, m.to_string()).unwrap();
+    swarmmap()
+        .arg("--model")
+        .arg(&path)
+        .args(["check", TINY])
+        .assert()
+        .code(2)
+        .stderr(contains("h1_span 1e308").and(contains("at most 1e12")));
+}
+
+#[test]
+fn map_refuses_an_overlap_as_long_as_a_window_and_drops_the_old_windows() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    // tiny: 210 s of log.
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .args(["--windows", "2", "--overlap", "1e9"])
+        .assert()
+        .code(2)
+        .stderr(contains("--overlap is 1000000000 s, not shorter than one window (105 s = 210 s of log / 2 windows)"));
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .args(["--windows", "100"])
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "the world's mapping.overlap is 30 s, not shorter than one window (2.1 s",
+        ));
+    // Five windows, then two: the files of windows 3-5 and their figures go.
+    for n in ["5", "2"] {
+        swarmmap()
+            .arg("map")
+            .arg(&run)
+            .args(["--windows", n, "--overlap", "10"])
+            .assert()
+            .success();
+    }
+    assert_eq!(
+        names(&run.join("maps")),
+        [
+            "connection_1.json",
+            "connections.json",
+            "global.json",
+            "window_1.json",
+            "window_2.json"
+        ]
+    );
+    let figures = names(&run.join("report"));
+    assert!(
+        figures.contains(&"window_2_diagram.svg".to_string()),
+        "{figures:?}"
+    );
+    assert!(
+        !figures
+            .iter()
+            .any(|f| f.starts_with("window_3") || f.starts_with("connection_2")),
+        "{figures:?}"
+    );
+}
+
+#[test]
+fn a_new_simulation_removes_what_was_derived_from_the_old_log() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    fs::write(run.join("notes.txt"), "mine").unwrap();
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--seed", "9", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    assert_eq!(
+        names(&run),
+        [
+            "encounters.csv",
+            "leader.csv",
+            "maps",
+            "meta.json",
+            "notes.txt",
+            "report",
+            "static_intervals.csv"
+        ]
+    );
+    assert!(names(&run.join("maps")).is_empty());
+    assert!(names(&run.join("report")).is_empty());
+    // The report now asks for maps of the new log instead of showing the old ones.
+    swarmmap().arg("report").arg(&run).assert().failure();
+}
+
+#[test]
+fn an_output_path_that_is_a_file_is_named_once_with_the_fix() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("afile");
+    fs::write(&file, "x").unwrap();
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--out"])
+        .arg(&file)
+        .assert()
+        .code(1)
+        .stderr(
+            contains("it is a file, not a directory; give --out a new or existing directory")
+                .and(contains("File exists").not()),
+        );
+    assert_eq!(fs::read_to_string(&file).unwrap(), "x");
+}
+
+#[test]
+fn a_world_name_cannot_lead_the_default_output_outside_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let world = std::env::current_dir().unwrap().join(TINY);
+    swarmmap()
+        .current_dir(tmp.path())
+        .arg("run")
+        .arg(&world)
+        .args(["--set", "name=../../esc", "--no-report", "--quiet"])
+        .assert()
+        .success()
+        .stdout(contains("outputs: runs/_._.._esc-seed3"));
+    assert_eq!(names(tmp.path()), ["runs"]);
+}
