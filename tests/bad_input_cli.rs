@@ -230,3 +230,73 @@ fn a_world_name_cannot_lead_the_default_output_outside_runs() {
         .stdout(contains("outputs: runs/_._.._esc-seed3"));
     assert_eq!(names(tmp.path()), ["runs"]);
 }
+
+#[test]
+fn calibrate_refuses_a_directory_as_its_output_before_training() {
+    let tmp = tempfile::tempdir().unwrap();
+    let runs = tmp.path().join("runs");
+    for flag in ["--out", "--landscape"] {
+        swarmmap()
+            .args(["calibrate", TINY, "--seeds", "1..1", flag])
+            .arg(tmp.path())
+            .arg("--runs")
+            .arg(&runs)
+            .assert()
+            .code(2)
+            .stderr(contains("is a directory; give the file to write"));
+        // Refused before any training run: none was kept.
+        assert!(!runs.exists() || names(&runs).is_empty());
+    }
+}
+
+#[test]
+fn a_trajectory_interval_longer_than_the_run_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    swarmmap()
+        .args([
+            "simulate",
+            TINY,
+            "--quiet",
+            "--trajectories",
+            "1e300",
+            "--out",
+        ])
+        .arg(tmp.path().join("r"))
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "option `trajectories` is 1e300: expected an interval no longer than the run",
+        ));
+}
+
+#[test]
+fn map_warns_where_the_log_and_its_world_disagree() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("r");
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    // An encounter long after tiny's 210 s, between agents the 40-agent world lacks.
+    let mut csv = fs::read_to_string(run.join("encounters.csv")).unwrap();
+    csv.push_str("5000.0,5001.0,7,100,1.0,1.0,1.05,1.0\n");
+    fs::write(run.join("encounters.csv"), csv).unwrap();
+    swarmmap().arg("map").arg(&run).assert().success().stderr(
+        contains("warning: 1 encounter(s) lie outside the run's 0–210 s").and(contains(
+            "warning: the log names agent 100, but the world has 40 agent(s)",
+        )),
+    );
+    // A log with no encounters maps to nothing, and says so.
+    fs::write(
+        run.join("encounters.csv"),
+        "start,end,a,b,a_x,a_y,b_x,b_y\n",
+    )
+    .unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .assert()
+        .success()
+        .stderr(contains("holds no encounters: every map is empty"));
+}

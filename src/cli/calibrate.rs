@@ -197,6 +197,24 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             args.max_false_holes
         )));
     }
+    // Found before the training runs, not after them.
+    for (flag, path) in [
+        ("--out", Some(&args.out)),
+        ("--landscape", args.landscape.as_ref()),
+    ] {
+        if let Some(p) = path.filter(|p| p.is_dir()) {
+            return Err(input(anyhow!(
+                "{flag} {} is a directory; give the file to write, e.g. {}",
+                p.display(),
+                p.join(if flag == "--out" {
+                    "classifier.json"
+                } else {
+                    "landscape.csv"
+                })
+                .display()
+            )));
+        }
+    }
     let mut paths = args.worlds.clone();
     if paths.is_empty() {
         let dir = PathBuf::from("worlds/training");

@@ -108,6 +108,17 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
         cfg.overlap = o;
     }
+    if log.encounters.is_empty() {
+        eprintln!(
+            "warning: {} holds no encounters: every map is empty",
+            args.run_dir.join("encounters.csv").display()
+        );
+    }
+    if let Some(w) = &world {
+        for line in disagreements(&log, w, cfg.span) {
+            eprintln!("warning: {line}");
+        }
+    }
     let length = (cfg.span.1 - cfg.span.0) / cfg.windows as f64;
     if cfg.overlap >= length {
         let whose = match (args.overlap, &world) {
@@ -176,4 +187,54 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         println!("report refreshed: {}", page.display());
     }
     Ok(())
+}
+
+/// Where a log and the world it is mapped with disagree: encounters outside the run's span
+/// (they fall in no window), agents the world does not have, a leader outside the arena.
+/// The log is still mapped (a real experiment's log need not match a world exactly), but
+/// the user hears of it, since the truth columns then describe another run.
+fn disagreements(
+    log: &EncounterLog,
+    world: &swarmmap::world::World,
+    span: (f64, f64),
+) -> Vec<String> {
+    let mut out = Vec::new();
+    let outside = log
+        .encounters
+        .iter()
+        .filter(|e| e.end < span.0 || e.start > span.1)
+        .count();
+    if outside > 0 {
+        out.push(format!(
+            "{outside} encounter(s) lie outside the run's {}–{} s and are in no window; is \
+             this the world the log came from (--world)?",
+            span.0, span.1
+        ));
+    }
+    let agents = world.swarm.agents;
+    let highest = log
+        .encounters
+        .iter()
+        .flat_map(|e| [e.a, e.b])
+        .chain(log.static_intervals.iter().map(|s| s.agent))
+        .max();
+    if let Some(h) = highest.filter(|&h| h as usize >= agents) {
+        out.push(format!(
+            "the log names agent {h}, but the world has {agents} agent(s) (0 to {}); is this \
+             the world the log came from (--world)?",
+            agents - 1
+        ));
+    }
+    let width = world.arena.width;
+    if let Some(&(t, x)) = log
+        .leader
+        .iter()
+        .find(|&&(_, x)| !(0.0..=width).contains(&x))
+    {
+        out.push(format!(
+            "the leader is at x = {x} m at t = {t} s, outside the {width} m arena; the \
+             windows' domains are clipped to the arena"
+        ));
+    }
+    out
 }

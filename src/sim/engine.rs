@@ -439,6 +439,16 @@ fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
             expected: "expected an interval in seconds greater than 0",
         });
     }
+    if let Some(i) = opts.trajectories
+        && i > world.total_duration().max(world.simulation.dt)
+    {
+        return Err(SimError::InvalidOption {
+            option: "trajectories",
+            value: i,
+            expected: "expected an interval no longer than the run (its dispersion and sweep); \
+                       a longer one records the start only",
+        });
+    }
     Ok(())
 }
 

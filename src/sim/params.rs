@@ -183,7 +183,7 @@ pub enum SimError {
         expected: &'static str,
     },
     /// A run option is out of range.
-    #[error("option `{option}` is {value}: {expected}")]
+    #[error("option `{option}` is {value:?}: {expected}")]
     InvalidOption {
         option: &'static str,
         value: f64,
