@@ -356,10 +356,9 @@ pub enum Alongside {
     /// cores: `swarmmap run` uses this.
     Free,
     /// As [`Alongside::Free`], but the simulation waits at each cut until the worker has
-    /// taken the prefix, so the worker maps every window whose prefix is handed out
-    /// (except perhaps the last one, which the simulation's end may overtake). Which
-    /// windows the worker maps then depends on the run alone, not on the machine's load:
-    /// for tests and for measuring the worker.
+    /// taken the prefix, and the worker maps every prefix it was handed before the rest
+    /// is mapped from the final log. Which windows the worker maps then depends on the run
+    /// alone, not on the machine's load: for tests and for measuring the worker.
     Lockstep,
 }
 
@@ -501,31 +500,41 @@ fn simulate_alongside(
         let sim = timings.time("simulation", || {
             simulate(world, &sim_opts.with_prefixes(&cuts, &hand_out))
         });
-        let taken = {
+        // Without lockstep the worker stops taking prefixes now, and the windows it has not
+        // started are mapped here from the final log while it finishes the one in progress.
+        // In lockstep it maps every prefix it was handed (none waits: each send waited for
+        // its receipt), and the rest is mapped once it is done.
+        let taken = (!lockstep).then(|| {
             let mut c = claims
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
             c.stop = true;
             c.taken.clone()
-        };
+        });
         drop(tx);
-        // The windows the worker has not started are mapped here from the final log, while
-        // it finishes the one in progress; waiting for it counts as mapping time.
-        let mine: Vec<(usize, LocalMap)> = match &sim {
-            Ok(out) => timings.time("local maps", || {
-                windows
-                    .par_iter()
-                    .enumerate()
-                    .filter(|(k, _)| !taken[*k])
-                    .map(|(k, w)| (k, local_map(&out.log, w, &cfg.local)))
-                    .collect()
-            }),
-            Err(_) => Vec::new(),
+        let rest = |taken: &[bool], timings: &mut Timings| -> Vec<(usize, LocalMap)> {
+            match &sim {
+                Ok(out) => timings.time("local maps", || {
+                    windows
+                        .par_iter()
+                        .enumerate()
+                        .filter(|(k, _)| !taken[*k])
+                        .map(|(k, w)| (k, local_map(&out.log, w, &cfg.local)))
+                        .collect()
+                }),
+                Err(_) => Vec::new(),
+            }
         };
+        let mine = taken.as_deref().map(|t| rest(t, timings));
+        // Waiting for the worker counts as mapping time.
         let (mut done, busy) = timings.time("local maps", || {
             worker
                 .join()
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        });
+        let mine = mine.unwrap_or_else(|| {
+            let taken: Vec<bool> = done.maps.iter().map(Option::is_some).collect();
+            rest(&taken, timings)
         });
         for (k, map) in mine {
             done.maps[k] = Some(map);

@@ -93,10 +93,11 @@ fn mapping_alongside_the_simulation_writes_what_mapping_afterwards_writes() {
                     "{sets:?} {mode:?}: {busy:?}"
                 );
                 if mode == Alongside::Lockstep {
-                    // Every prefix handed out but the last is mapped by the worker, and
-                    // each of these runs hands out at least three consecutive ones: the
-                    // worker maps windows and connects two of them, whatever the load.
-                    // (Without lockstep how much it does depends on the machine.)
+                    // Every prefix handed out is mapped by the worker, and each of these
+                    // runs hands out at least two consecutive ones (the last window's is
+                    // never handed out: the run's end settles it): the worker maps windows
+                    // and connects two of them, whatever the load. (Without lockstep how
+                    // much it does depends on the machine.)
                     let maps = busy.get("local maps").copied();
                     assert!(maps.is_some_and(|s| s > 0.0), "{sets:?}: {busy:?}");
                     assert!(busy.contains_key("stitching"), "{sets:?}: {busy:?}");

@@ -124,7 +124,9 @@ fn map_refuses_an_overlap_as_long_as_a_window_and_drops_the_old_windows() {
         .args(["--windows", "2", "--overlap", "1e9"])
         .assert()
         .code(2)
-        .stderr(contains("--overlap is 1000000000 s, not shorter than one window (105 s = 210 s of log / 2 windows)"));
+        .stderr(contains(
+            "--overlap is 1e9 s, not shorter than one window (105 s = 210 s of log / 2 windows)",
+        ));
     swarmmap()
         .arg("map")
         .arg(&run)
@@ -299,4 +301,39 @@ fn map_warns_where_the_log_and_its_world_disagree() {
         .assert()
         .success()
         .stderr(contains("holds no encounters: every map is empty"));
+}
+
+/// The names swarmmap derives from a log are common ones: in a directory that does not
+/// hold a swarmmap run (no `meta.json` of ours) a new simulation removes none of them.
+#[test]
+fn a_simulation_into_a_users_own_directory_removes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("mine");
+    fs::create_dir_all(dir.join("maps")).unwrap();
+    fs::create_dir_all(dir.join("report")).unwrap();
+    for f in [
+        "summary.json",
+        "trajectories.csv",
+        "maps/global.json",
+        "report/index.html",
+    ] {
+        fs::write(dir.join(f), "the user's").unwrap();
+    }
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--out"])
+        .arg(&dir)
+        .assert()
+        .success();
+    for f in [
+        "summary.json",
+        "trajectories.csv",
+        "maps/global.json",
+        "report/index.html",
+    ] {
+        assert_eq!(
+            fs::read_to_string(dir.join(f)).unwrap(),
+            "the user's",
+            "{f}"
+        );
+    }
 }

@@ -1430,6 +1430,12 @@ fn a_tall_arena_is_checked_without_a_panic() {
     if let Err(err) = World::from_str_named(&text, ORIGIN) {
         assert_world_error(&err, &text).unwrap();
     }
+    // The check now refuses it (sides over 10 km) before any raster; a `World` built in
+    // code still reaches the raster, whose counts stay clamped.
+    let mut world = World::from_str_named(CHECKED_WORLDS[0].1, ORIGIN).expect("valid");
+    world.arena.height = 1e300;
+    let raster = FreeSpaceRaster::new(&world, world.swarm.body_radius);
+    assert!(raster.nx * raster.ny <= 4_000_000);
 }
 
 /// Regression, the same cause short of a panic: an arena of aspect ratio r > 4e6 got

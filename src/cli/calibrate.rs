@@ -29,8 +29,8 @@ pub struct CalibrateArgs {
     /// Override a field of every training world, e.g. `--set mapping.method=Embedded`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     pub set: Vec<String>,
-    /// Runs in parallel (default: the number of cores).
-    #[arg(long)]
+    /// Runs in parallel (default: the number of cores; at most 1024).
+    #[arg(long, value_parser = super::thread_count)]
     pub jobs: Option<usize>,
     /// Model file to update (default: `assets/classifier.json`, the model compiled into
     /// swarmmap). The fitted model replaces the models of the fitted method (or the oracle)

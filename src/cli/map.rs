@@ -13,6 +13,7 @@ use swarmmap::mapping::stitch::StitchParams;
 use swarmmap::pipeline::{
     PipelineError, Timings, map_log, seed_from_run, world_from_run, write_maps,
 };
+use swarmmap::world::short;
 use swarmmap::world::{MappingMethod, MappingParams};
 
 /// Options of `swarmmap map`.
@@ -130,11 +131,11 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             "{whose} is {} s, not shorter than one window ({} s = {} s of log / {} windows), \
              so every window would span the whole log; pass --overlap below {} s, or fewer \
              --windows",
-            cfg.overlap,
-            (length * 1e3).round() / 1e3,
-            ((cfg.span.1 - cfg.span.0) * 1e3).round() / 1e3,
+            short(cfg.overlap),
+            short(length),
+            short(cfg.span.1 - cfg.span.0),
             cfg.windows,
-            (length * 1e3).round() / 1e3,
+            short(length),
         )));
     }
     if let Some(method) = args.method {

@@ -46,7 +46,6 @@ pub fn load_world(
     spec.check().map_err(input)
 }
 
-/// A progress bar on stderr when it is a terminal and `quiet` is off.
 /// Most worker threads a command takes (`--jobs`, `--threads`): far beyond any machine's
 /// cores, and a bound on the stacks a typo would otherwise ask for.
 pub const MAX_THREADS: usize = 1024;
@@ -66,6 +65,7 @@ pub fn thread_count(text: &str) -> Result<usize, String> {
     Ok(n)
 }
 
+/// A progress bar on stderr when it is a terminal and `quiet` is off.
 pub fn progress_bar(quiet: bool, label: &str) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     (!quiet && std::io::stderr().is_terminal()).then(|| {
@@ -145,15 +145,15 @@ pub fn main() -> ExitCode {
 }
 
 /// An error and its causes, `: `-separated as anyhow's `{:#}` writes them, but without a
-/// cause that the message before it already quotes (our errors name their source in their
-/// own text, as "cannot write X: <the OS error>").
+/// cause that the message before it already ends with (our errors name their source in
+/// their own text, as "cannot write X: <the OS error>").
 fn describe(e: &anyhow::Error) -> String {
     let mut text = String::new();
     for cause in e.chain() {
         let part = cause.to_string();
         if text.is_empty() {
             text = part;
-        } else if !text.contains(&part) {
+        } else if !text.ends_with(&part) {
             text.push_str(": ");
             text.push_str(&part);
         }

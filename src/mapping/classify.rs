@@ -382,7 +382,7 @@ impl Models {
                     && !(0.0..=MAX_THRESHOLD).contains(&x)
                 {
                     anyhow::bail!(
-                        "{}: the {name} model's h1_stability is {x}; it is the least life, in \
+                        "{}: the {name} model's h1_stability is {x:?}; it is the least life, in \
                          σ, that both halves of a window must give a hole, a number from 0 to \
                          1e12 (or leave it out for no stability test)",
                         path.display()

@@ -440,13 +440,13 @@ fn check(world: &World, opts: &SimOptions) -> Result<(), SimError> {
         });
     }
     if let Some(i) = opts.trajectories
-        && i > world.total_duration().max(world.simulation.dt)
+        && i > world.total_duration().max(1.0)
     {
         return Err(SimError::InvalidOption {
             option: "trajectories",
             value: i,
-            expected: "expected an interval no longer than the run (its dispersion and sweep); \
-                       a longer one records the start only",
+            expected: "expected an interval no longer than the run (its dispersion and sweep) \
+                       or 1 s; a longer one records the start only",
         });
     }
     Ok(())

@@ -230,12 +230,26 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
 /// `connections.json`, `global.json`), the report (`report/`: `index.html` and its
 /// figures) and, when this run records none, `trajectories.csv`. Left in place they would
 /// be read as the new log's (a report pairing the new maps with the old replay). Only
-/// those files of swarmmap's are removed; anything else in `dir` stays.
-fn remove_derived(dir: &Path, trajectories: bool) -> std::io::Result<()> {
+/// when `dir` holds a swarmmap run (its `meta.json` says so: these names are common
+/// enough that a user's own directory may hold them), and only those files of
+/// swarmmap's; anything else in `dir` stays.
+fn remove_derived(dir: &Path, remove_trajectories: bool) -> std::io::Result<()> {
     use crate::io::{numbered, remove_stale};
+    let ours = std::fs::read(dir.join("meta.json"))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| {
+            v.get("format")?
+                .as_str()
+                .map(|f| f.starts_with("swarmmap-simulation/"))
+        })
+        .unwrap_or(false);
+    if !ours {
+        return Ok(());
+    }
     let none = std::collections::BTreeSet::new();
     let mut files = vec!["summary.json"];
-    if trajectories {
+    if remove_trajectories {
         files.push("trajectories.csv");
     }
     remove_stale(dir, &none, |n| files.contains(&n))?;

@@ -290,8 +290,9 @@ fn collinear(points: &[Vec2]) -> bool {
     })
 }
 
-/// A computed number, rounded to 6 significant digits for messages.
-fn short(x: f64) -> String {
+/// A computed number, rounded to 6 significant digits for messages (mantissa and exponent
+/// far from 1).
+pub fn short(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }

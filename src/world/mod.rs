@@ -18,7 +18,7 @@ mod spec;
 mod summary;
 mod types;
 
-pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count};
+pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count, short};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;
 pub use geometry::{
