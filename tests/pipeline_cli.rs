@@ -375,18 +375,27 @@ fn eval_does_not_reuse_runs_judged_by_another_model() {
         fs::read_to_string(out.join("eval.csv")).unwrap()
     };
     let shipped = eval(None);
-    // No H1 bar of a finite diagram has death / birth ≥ 10⁹: no window shows a hole.
-    let strict = model_file(tmp.path(), "strict.json", 1e9, 0.0);
-    let judged = eval(Some(&strict));
+    // Every H1 bar is a hole: each window shows at least one (the shipped model finds
+    // none on this seed).
+    let lenient = model_file(tmp.path(), "lenient.json", 1.0, 0.0);
+    let judged = eval(Some(&lenient));
     assert_eq!(fs::read_dir(out.join("runs")).unwrap().count(), 2);
-    let row = judged.lines().nth(1).unwrap();
-    let betti = row.split(',').nth(18).unwrap();
-    assert!(betti.split(' ').all(|w| w.ends_with(":0")), "{row}");
-    assert_ne!(
-        shipped, judged,
-        "the shipped model finds the tiny world's hole"
+    // The window Betti numbers, column 18 (not the row: its `seconds` differ anyway).
+    let betti = |csv: &str| {
+        csv.lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .nth(18)
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(betti(&shipped), "1:0 1:0", "{shipped}");
+    assert!(
+        betti(&judged).split(' ').all(|w| !w.ends_with(":0")),
+        "{judged}"
     );
-    assert_eq!(eval(Some(&strict)), judged);
+    assert_eq!(eval(Some(&lenient)), judged);
     assert_eq!(eval(None), shipped);
     assert_eq!(fs::read_dir(out.join("runs")).unwrap().count(), 2);
 }
