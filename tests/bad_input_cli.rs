@@ -337,3 +337,23 @@ fn a_simulation_into_a_users_own_directory_removes_nothing() {
         );
     }
 }
+
+#[test]
+fn messages_for_an_obstacle_field_override_and_a_report_of_a_file() {
+    swarmmap()
+        .args(["check", TINY, "--set", "obstacles[0].radius=2"])
+        .assert()
+        .code(2)
+        .stderr(contains("an obstacle is set whole, not field by field"));
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("summary.json");
+    fs::write(&file, "{}").unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&file)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "a file, not a run directory; give the directory that holds the run's summary.json",
+        ));
+}

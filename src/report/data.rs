@@ -377,6 +377,20 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
 
 /// Reads and checks everything the report needs from a run directory.
 pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
+    if dir.is_file() {
+        let parent = dir
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        return Err(invalid(
+            dir,
+            format!(
+                "a file, not a run directory; give the directory that holds the run's \
+                 summary.json (perhaps {})",
+                parent.display()
+            ),
+        ));
+    }
     if !dir.is_dir() {
         return Err(ReportError::Missing {
             path: dir.to_path_buf(),

@@ -764,8 +764,8 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
         if free < need.max(f64::MIN_POSITIVE) {
             return Err(ctx.err(
                 "swarm.placement",
-                format!("is the initial window x {} to {} m, which has {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", xs - half, xs + half, world.swarm.agents),
-                "clear space in the first window, move leader.start_x, or use fewer agents",
+                format!("is the initial window x {} to {} m, which has {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", short(xs - half), short(xs + half), world.swarm.agents),
+                "clear space in the first window, move leader.start_x, widen leader.window, or use fewer agents",
             ));
         }
     }

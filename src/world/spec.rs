@@ -394,6 +394,16 @@ impl WorldSpec {
                     .and_then(|r| r.strip_suffix(']'))
                     .and_then(|i| i.parse::<usize>().ok());
                 let count = self.obstacles.as_ref().map_or(0, Vec::len);
+                if p.contains("].") {
+                    return Err(WorldError::BadSetting {
+                        path: path.to_string(),
+                        value: value.to_string(),
+                        message: "an obstacle is set whole, not field by field: e.g. \
+                                  `obstacles[0]=Circle(center: (3.0, 2.0), radius: 0.5)`, or \
+                                  `obstacles.scale=1.25` to grow every obstacle"
+                            .into(),
+                    });
+                }
                 let Some(i) = index.filter(|i| *i < count) else {
                     return Err(WorldError::BadSetting {
                         path: path.to_string(),
