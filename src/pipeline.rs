@@ -128,8 +128,15 @@ pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
         .get("world")
         .cloned()
         .ok_or_else(|| meta_err("has no `world` object; is it a swarmmap run?".into()))?;
-    let mut spec: WorldSpec = serde_json::from_value(world)
-        .map_err(|e| meta_err(format!("its `world` is not a valid world: {e}")))?;
+    // With the path of the field at fault: "world.arena.width: invalid type: …".
+    let mut spec: WorldSpec = serde_path_to_error::deserialize(world).map_err(|e| {
+        meta_err(format!(
+            "its `world` is not a valid world: world.{}: {}; fix that field, or simulate \
+             the run again",
+            e.path(),
+            e.inner()
+        ))
+    })?;
     spec.origin.name = format!("{} (world)", path.display());
     Ok(Some(spec.check()?))
 }

@@ -357,3 +357,41 @@ fn messages_for_an_obstacle_field_override_and_a_report_of_a_file() {
             "a file, not a run directory; give the directory that holds the run's summary.json",
         ));
 }
+
+#[test]
+fn a_fraction_where_a_whole_number_belongs_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("f.ron");
+    fs::write(&path, "(swarm: (agents: 10.5))").unwrap();
+    swarmmap()
+        .arg("check")
+        .arg(&path)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "f.ron:1:20: a whole number is expected here, not a fraction",
+        ));
+}
+
+#[test]
+fn a_bad_field_in_meta_json_is_named_by_its_path() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("r");
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap();
+    meta["world"]["arena"]["width"] = serde_json::json!("wide");
+    fs::write(run.join("meta.json"), meta.to_string()).unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "world.arena.width: invalid type: string \"wide\", expected f64",
+        ));
+}

@@ -263,14 +263,27 @@ fn explain(code: &ron::Error) -> String {
 pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError> {
     // A byte-order mark (some Windows editors write one) is not part of the RON text.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut spec: WorldSpec = ron_options()
-        .from_str(text)
-        .map_err(|e| WorldError::Syntax {
+    let mut spec: WorldSpec = ron_options().from_str(text).map_err(|e| {
+        let (line, col) = (e.span.start.line, e.span.start.col);
+        // `agents: 10.5`: ron reads the integer 10, then stops at the `.`.
+        let at = text.lines().nth(line.saturating_sub(1)).map(|l| {
+            let mut chars = l.chars().skip(col.saturating_sub(2));
+            (chars.next(), chars.next())
+        });
+        let fraction = matches!(at, Some((Some(d), Some('.'))) if d.is_ascii_digit());
+        WorldError::Syntax {
             origin: origin_name.to_string(),
-            line: e.span.start.line,
-            col: e.span.start.col,
-            message: explain(&e.code),
-        })?;
+            line,
+            col,
+            message: if matches!(e.code, ron::Error::ExpectedComma) && fraction {
+                "a whole number is expected here, not a fraction (counts and the seed are \
+                     integers, e.g. `agents: 100`)"
+                    .into()
+            } else {
+                explain(&e.code)
+            },
+        }
+    })?;
     spec.origin = SpecOrigin {
         name: origin_name.to_string(),
         text: Some(text.to_string()),
