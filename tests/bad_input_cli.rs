@@ -14,6 +14,17 @@ fn swarmmap() -> Command {
     Command::cargo_bin("swarmmap").expect("binary built")
 }
 
+/// `swarmmap simulate` (or `run`) of the tiny world into `dir/r`.
+fn tiny_run(dir: &Path, command: &str) -> std::path::PathBuf {
+    let run = dir.join("r");
+    swarmmap()
+        .args([command, TINY, "--quiet", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    run
+}
+
 fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = fs::read_dir(dir)
         .unwrap()
@@ -111,12 +122,7 @@ fn a_model_threshold_near_the_largest_float_is_refused() {
 #[test]
 fn map_refuses_an_overlap_as_long_as_a_window_and_drops_the_old_windows() {
     let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("r");
-    swarmmap()
-        .args(["run", TINY, "--quiet", "--out"])
-        .arg(&run)
-        .assert()
-        .success();
+    let run = tiny_run(tmp.path(), "run");
     // tiny: 210 s of log.
     swarmmap()
         .arg("map")
@@ -171,12 +177,7 @@ fn map_refuses_an_overlap_as_long_as_a_window_and_drops_the_old_windows() {
 #[test]
 fn a_new_simulation_removes_what_was_derived_from_the_old_log() {
     let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("r");
-    swarmmap()
-        .args(["run", TINY, "--quiet", "--out"])
-        .arg(&run)
-        .assert()
-        .success();
+    let run = tiny_run(tmp.path(), "run");
     fs::write(run.join("notes.txt"), "mine").unwrap();
     swarmmap()
         .args(["simulate", TINY, "--quiet", "--seed", "9", "--out"])
@@ -274,12 +275,7 @@ fn a_trajectory_interval_longer_than_the_run_is_refused() {
 #[test]
 fn map_warns_where_the_log_and_its_world_disagree() {
     let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("r");
-    swarmmap()
-        .args(["simulate", TINY, "--quiet", "--out"])
-        .arg(&run)
-        .assert()
-        .success();
+    let run = tiny_run(tmp.path(), "simulate");
     // An encounter long after tiny's 210 s, between agents the 40-agent world lacks.
     let mut csv = fs::read_to_string(run.join("encounters.csv")).unwrap();
     csv.push_str("5000.0,5001.0,7,100,1.0,1.0,1.05,1.0\n");
@@ -376,12 +372,7 @@ fn a_fraction_where_a_whole_number_belongs_is_named() {
 #[test]
 fn a_bad_field_in_meta_json_is_named_by_its_path() {
     let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("r");
-    swarmmap()
-        .args(["simulate", TINY, "--quiet", "--out"])
-        .arg(&run)
-        .assert()
-        .success();
+    let run = tiny_run(tmp.path(), "simulate");
     let mut meta: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap();
     meta["world"]["arena"]["width"] = serde_json::json!("wide");
