@@ -147,10 +147,10 @@ mod tests {
 }
 
 /// Removes the files of `dir` that an earlier run wrote and this one did not: those whose
-/// name `ours` recognises as swarmmap's per-window or per-connection outputs and that are
-/// not in `written`. Mapping a log again with fewer windows (`swarmmap map --windows`)
-/// would otherwise leave the old windows' files beside the new ones, to be read as theirs.
-/// Nothing else is touched; a missing `dir` is nothing to do.
+/// name `ours` recognises as swarmmap's and that are not in `written`. Mapping a log again
+/// with fewer windows (`swarmmap map --windows`) would otherwise leave the old windows'
+/// files beside the new ones, to be read as theirs. Nothing else is touched; a missing
+/// `dir` is nothing to do.
 pub fn remove_stale(
     dir: &Path,
     written: &std::collections::BTreeSet<String>,
@@ -171,11 +171,22 @@ pub fn remove_stale(
     Ok(())
 }
 
-/// Whether `name` is `{prefix}_{N}{rest}` for some `prefix` of `prefixes`, a number `N`
-/// and a `rest` that `tail` accepts: the shape of swarmmap's per-window and per-connection
-/// files, for [`remove_stale`].
-pub fn numbered(name: &str, prefixes: &[&str], tail: impl Fn(&str) -> bool) -> bool {
-    prefixes.iter().any(|p| {
+/// Whether `name` is one of `maps/`'s per-window or per-connection files
+/// (`window_<i>.json`, `connection_<i>.json`), for [`remove_stale`].
+pub fn is_numbered_map(name: &str) -> bool {
+    numbered(name, |rest| rest == ".json")
+}
+
+/// Whether `name` is one of `report/`'s per-window or per-connection figures
+/// (`window_<i>_<kind>.svg`, `connection_<i>_<kind>.svg`), for [`remove_stale`].
+pub fn is_numbered_figure(name: &str) -> bool {
+    numbered(name, |rest| rest.starts_with('_') && rest.ends_with(".svg"))
+}
+
+/// Whether `name` is `window_<N><rest>` or `connection_<N><rest>` for a number `N` and a
+/// `rest` that `tail` accepts.
+fn numbered(name: &str, tail: impl Fn(&str) -> bool) -> bool {
+    ["window", "connection"].iter().any(|p| {
         name.strip_prefix(p)
             .and_then(|r| r.strip_prefix('_'))
             .is_some_and(|r| {
@@ -210,10 +221,7 @@ mod stale_tests {
             .into_iter()
             .map(String::from)
             .collect();
-        remove_stale(tmp.path(), &written, |n| {
-            numbered(n, &["window", "connection"], |r| r == ".json")
-        })
-        .unwrap();
+        remove_stale(tmp.path(), &written, is_numbered_map).unwrap();
         let mut left: Vec<String> = fs::read_dir(tmp.path())
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
@@ -229,6 +237,9 @@ mod stale_tests {
                 "window_x.json"
             ]
         );
+        assert!(is_numbered_figure("window_3_diagram.svg"));
+        assert!(is_numbered_figure("connection_12_cloud.svg"));
+        assert!(!is_numbered_figure("window_3.json") && !is_numbered_figure("global.svg"));
         // A directory that does not exist is nothing to clean.
         remove_stale(&tmp.path().join("none"), &written, |_| true).unwrap();
     }

@@ -5,7 +5,7 @@
 //! disk; `swarmmap eval` calls [`run_world`] for many worlds and seeds in parallel.
 
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
-use crate::io::{numbered, remove_stale, write_atomic};
+use crate::io::{is_numbered_map, remove_stale, write_atomic};
 use crate::log::{EncounterLog, LogError};
 use crate::mapping::local::LocalMap;
 use crate::mapping::local::local_map;
@@ -325,10 +325,8 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     write("summary.json".into(), to_json(&m.summary))?;
     // A log mapped before with more windows left files these maps do not replace.
     let maps = dir.join("maps");
-    remove_stale(&maps, &written.borrow(), |n| {
-        numbered(n, &["window", "connection"], |rest| rest == ".json")
-    })
-    .map_err(|source| PipelineError::Write { path: maps, source })?;
+    remove_stale(&maps, &written.borrow(), is_numbered_map)
+        .map_err(|source| PipelineError::Write { path: maps, source })?;
     Ok(())
 }
 

@@ -122,14 +122,11 @@ pub fn write_report(dir: &Path) -> Result<Written, ReportError> {
     // Figures of windows and connections an earlier mapping had and this one has not.
     let names: std::collections::BTreeSet<String> =
         report.figures.iter().map(|f| f.name.clone()).collect();
-    crate::io::remove_stale(&out, &names, |n| {
-        crate::io::numbered(n, &["window", "connection"], |rest| {
-            rest.starts_with('_') && rest.ends_with(".svg")
-        })
-    })
-    .map_err(|source| ReportError::Write {
-        path: out.clone(),
-        source,
+    crate::io::remove_stale(&out, &names, crate::io::is_numbered_figure).map_err(|source| {
+        ReportError::Write {
+            path: out.clone(),
+            source,
+        }
     })?;
     Ok(Written {
         index,

@@ -234,7 +234,7 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
 /// enough that a user's own directory may hold them), and only those files of
 /// swarmmap's; anything else in `dir` stays.
 fn remove_derived(dir: &Path, remove_trajectories: bool) -> std::io::Result<()> {
-    use crate::io::{numbered, remove_stale};
+    use crate::io::{is_numbered_figure, is_numbered_map, remove_stale};
     let ours = std::fs::read(dir.join("meta.json"))
         .ok()
         .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
@@ -254,15 +254,10 @@ fn remove_derived(dir: &Path, remove_trajectories: bool) -> std::io::Result<()> 
     }
     remove_stale(dir, &none, |n| files.contains(&n))?;
     remove_stale(&dir.join("maps"), &none, |n| {
-        n == "connections.json"
-            || n == "global.json"
-            || numbered(n, &["window", "connection"], |rest| rest == ".json")
+        matches!(n, "connections.json" | "global.json") || is_numbered_map(n)
     })?;
     remove_stale(&dir.join("report"), &none, |n| {
-        matches!(n, "index.html" | "environment.svg" | "global.svg")
-            || numbered(n, &["window", "connection"], |rest| {
-                rest.starts_with('_') && rest.ends_with(".svg")
-            })
+        matches!(n, "index.html" | "environment.svg" | "global.svg") || is_numbered_figure(n)
     })
 }
 
