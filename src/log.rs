@@ -269,6 +269,20 @@ struct Row<'a> {
     columns: &'a Columns,
 }
 
+/// A cell as an error message shows it: control characters (a NUL byte, a tab) escaped,
+/// so that a message shows what the file holds.
+pub(crate) fn shown(cell: &str) -> String {
+    let mut out = String::with_capacity(cell.len());
+    for c in cell.chars() {
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 impl Row<'_> {
     fn text(&self, name: &str) -> Option<&str> {
         self.columns.get(name).and_then(|i| self.record.get(i))
@@ -278,10 +292,11 @@ impl Row<'_> {
         let s = self.text(name).unwrap_or("");
         let v: f64 = s
             .parse()
-            .map_err(|_| format!("column `{name}` is `{s}`, which is not a number"))?;
+            .map_err(|_| format!("column `{name}` is `{}`, which is not a number", shown(s)))?;
         if !v.is_finite() {
             return Err(format!(
-                "column `{name}` is `{s}`; times and positions must be finite numbers"
+                "column `{name}` is `{}`; times and positions must be finite numbers",
+                shown(s)
             ));
         }
         Ok(v)
@@ -293,7 +308,7 @@ impl Row<'_> {
         if v.abs() > max {
             return Err(format!(
                 "column `{name}` is `{}`, beyond ±{limit}; {hint}",
-                self.text(name).unwrap_or("")
+                shown(self.text(name).unwrap_or(""))
             ));
         }
         Ok(v)
@@ -321,8 +336,12 @@ impl Row<'_> {
 
     fn agent(&self, name: &str) -> Result<AgentId, String> {
         let s = self.text(name).unwrap_or("");
-        s.parse()
-            .map_err(|_| format!("column `{name}` is `{s}`; agent ids are non-negative integers"))
+        s.parse().map_err(|_| {
+            format!(
+                "column `{name}` is `{}`; agent ids are non-negative integers",
+                shown(s)
+            )
+        })
     }
 }
 
@@ -440,7 +459,8 @@ fn read_static(path: &Path) -> Result<Vec<StaticInterval>, LogError> {
             Some("pause") => StaticReason::Pause,
             Some(other) => {
                 return Err(format!(
-                    "column `reason` is `{other}`; use `landmark` or `pause`"
+                    "column `reason` is `{}`; use `landmark` or `pause`",
+                    shown(other)
                 ));
             }
         };
@@ -557,6 +577,12 @@ mod tests {
         );
         let e = error_of("start,end,a,b\n0,1,4,4\n");
         assert!(e.contains(":2: agent 4 meets itself"), "{e}");
+        // A control character in a cell is shown, not printed raw.
+        let e = error_of("start,end,a,b\n0,1\0,4,5\n");
+        assert!(
+            e.contains(":2: column `end` is `1\\0`, which is not a number"),
+            "{e}"
+        );
         let d = tempfile::tempdir().unwrap();
         let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
         assert!(e.contains("file not found"), "{e}");

@@ -386,3 +386,53 @@ fn a_bad_field_in_meta_json_is_named_by_its_path() {
             "world.arena.width: invalid type: string \"wide\", expected f64",
         ));
 }
+
+#[test]
+fn an_empty_or_sample_free_trajectories_file_is_named_as_such() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "run");
+    fs::write(run.join("trajectories.csv"), "").unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&run)
+        .assert()
+        .code(2)
+        .stderr(contains("trajectories.csv: the file is empty").and(contains("delete it")));
+    fs::write(run.join("trajectories.csv"), "time,agent,x,y,state\n").unwrap();
+    swarmmap().arg("report").arg(&run).assert().success();
+    let html = fs::read_to_string(run.join("report/index.html")).unwrap();
+    assert!(
+        html.contains("<code>trajectories.csv</code> holds no samples"),
+        "the replay's absence is explained"
+    );
+}
+
+#[test]
+fn a_control_character_in_a_cell_is_shown_escaped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "run");
+    let text = fs::read_to_string(run.join("trajectories.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    lines[1] = lines[1].replacen(',', "\u{0},", 1);
+    fs::write(run.join("trajectories.csv"), lines.join("\n") + "\n").unwrap();
+    swarmmap()
+        .arg("report")
+        .arg(&run)
+        .assert()
+        .code(2)
+        .stderr(contains("line 2: column `time` is `").and(contains("\\0`, not a finite number")));
+}
+
+#[test]
+fn set_accepts_some_and_none_and_refuses_a_half_quoted_name() {
+    swarmmap()
+        .args(["check", TINY, "--set", "swarm.agents=Some(12)"])
+        .assert()
+        .success()
+        .stdout(contains("12 agents"));
+    swarmmap()
+        .args(["check", TINY, "--set", "name=\"abc"])
+        .assert()
+        .code(2)
+        .stderr(contains("a quoted name must be one whole string"));
+}

@@ -641,9 +641,23 @@ struct Expected {
     needles: Vec<String>,
 }
 
+/// A cell as the documented messages show it: control characters as Rust escapes them
+/// (`\0`, `\t`, `\u{1b}`), everything else as it is.
+fn shown(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_debug().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// A number under the documented rules: Rust's float syntax, finite, within ±`max`.
 fn number(name: &str, s: &str, max: f64) -> Result<f64, Vec<String>> {
-    let culprit = format!("column `{name}` is `{s}`");
+    let culprit = format!("column `{name}` is `{}`", shown(s));
     match s.parse::<f64>() {
         Err(_) => Err(vec![culprit, "not a number".into()]),
         Ok(v) if !v.is_finite() => Err(vec![culprit, "must be finite".into()]),
@@ -655,7 +669,7 @@ fn number(name: &str, s: &str, max: f64) -> Result<f64, Vec<String>> {
 fn agent(name: &str, s: &str) -> Result<u32, Vec<String>> {
     s.parse::<u32>().map_err(|_| {
         vec![
-            format!("column `{name}` is `{s}`"),
+            format!("column `{name}` is `{}`", shown(s)),
             "agent ids are non-negative integers".into(),
         ]
     })
@@ -738,7 +752,7 @@ fn oracle(t: &Table) -> Result<EncounterLog, Expected> {
                     Some("pause") => StaticReason::Pause,
                     Some(other) => {
                         return Err(vec![
-                            format!("column `reason` is `{other}`"),
+                            format!("column `reason` is `{}`", shown(other)),
                             "use `landmark` or `pause`".into(),
                         ]);
                     }

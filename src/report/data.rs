@@ -314,6 +314,15 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
         .headers()
         .map_err(|e| invalid(path, format!("line 1: {e}")))?;
     let expected = ["time", "agent", "x", "y", "state"];
+    if headers.is_empty() {
+        return Err(invalid(
+            path,
+            format!(
+                "the file is empty; it needs the header {} and a row per sample (delete it to report without the replay)",
+                expected.join(",")
+            ),
+        ));
+    }
     if headers.iter().collect::<Vec<_>>() != expected {
         return Err(invalid(
             path,
@@ -336,7 +345,7 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
                         format!(
                             "line {line}: column `{}` is `{}`, not a finite number",
                             expected[i],
-                            field(i)
+                            crate::log::shown(field(i))
                         ),
                     )
                 })
@@ -346,7 +355,7 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
                 path,
                 format!(
                     "line {line}: column `agent` is `{}`, not an agent id",
-                    field(1)
+                    crate::log::shown(field(1))
                 ),
             )
         })?;
@@ -358,7 +367,10 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
             other => {
                 return Err(invalid(
                     path,
-                    format!("line {line}: state `{other}` is not walk, pause, landmark or return"),
+                    format!(
+                        "line {line}: state `{}` is not walk, pause, landmark or return",
+                        crate::log::shown(other)
+                    ),
                 ));
             }
         };

@@ -331,6 +331,7 @@ pub fn page(run: &RunData, figures: &[Figure], replay: Option<&Replay>) -> Strin
                 replay_json(run, r)
             );
         }
+        None if run.trajectories.is_some() => h.push_str("<p id=\"replay-unavailable\">Replay unavailable: this run's <code>trajectories.csv</code> holds no samples.</p>\n"),
         None => h.push_str("<p id=\"replay-unavailable\">Replay unavailable: this run has no <code>trajectories.csv</code>. <code>swarmmap run</code> records one by default; <code>swarmmap simulate --trajectories</code> does on request.</p>\n"),
     }
     h.push_str("</section>\n<section id=\"figures\">\n<h2>Figures</h2>\n");

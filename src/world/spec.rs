@@ -339,24 +339,29 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.split_stability",
 ];
 
-/// Parses `value` as RON of the slot's type and stores it.
+/// Parses `value` as RON of the slot's type and stores it. As in a world file, the value
+/// may be written bare or as `Some(…)`; `None` clears the slot, so the setting takes its
+/// default (or, for a section, every setting of the section does).
 fn put<T: DeserializeOwned>(
     slot: &mut Option<T>,
     path: &str,
     value: &str,
 ) -> Result<(), WorldError> {
-    let v = ron_options()
+    *slot = ron_options()
         .from_str(value)
-        .map_err(|e| WorldError::BadSetting {
-            path: path.to_string(),
-            value: value.to_string(),
-            message: format!(
-                "the value does not parse: {}; write it as in a world file, e.g. `0.5`, `100`, `Window`, `(width: 20.0)`",
-                explain(&e.code)
-            ),
-        })?;
-    *slot = Some(v);
+        .map_err(|e| bad_value(path, value, &e.code))?;
     Ok(())
+}
+
+fn bad_value(path: &str, value: &str, code: &ron::Error) -> WorldError {
+    WorldError::BadSetting {
+        path: path.to_string(),
+        value: value.to_string(),
+        message: format!(
+            "the value does not parse: {}; write it as in a world file, e.g. `0.5`, `100`, `Window`, `(width: 20.0)`",
+            explain(code)
+        ),
+    }
 }
 
 impl WorldSpec {
@@ -370,8 +375,21 @@ impl WorldSpec {
         let v = value.trim();
         match p {
             "name" => {
-                if put(&mut self.name, p, v).is_err() {
-                    self.name = Some(v.to_string());
+                // A bare word is a name too; a quoted one must be a whole RON string.
+                match ron_options().from_str::<String>(v) {
+                    Ok(name) => self.name = Some(name),
+                    Err(e) if v.starts_with('"') || v.starts_with("r\"") || v.starts_with("r#") => {
+                        return Err(WorldError::BadSetting {
+                            path: path.to_string(),
+                            value: value.to_string(),
+                            message: format!(
+                                "a quoted name must be one whole string ({}): close the quote, \
+                                 e.g. `name=\"my world\"`, or give a bare word, e.g. `name=lab-7`",
+                                explain(&e.code)
+                            ),
+                        });
+                    }
+                    Err(_) => self.name = Some(v.to_string()),
                 }
             }
             "seed" => put(&mut self.seed, p, v)?,
@@ -429,7 +447,17 @@ impl WorldSpec {
                 };
                 let mut one = None;
                 put(&mut one, p, v)?;
-                if let (Some(list), Some(o)) = (self.obstacles.as_mut(), one) {
+                let Some(o) = one else {
+                    return Err(WorldError::BadSetting {
+                        path: path.to_string(),
+                        value: value.to_string(),
+                        message:
+                            "an obstacle cannot be `None`; to remove obstacles, set the whole \
+                                  `obstacles` list, e.g. `obstacles=[]`"
+                                .into(),
+                    });
+                };
+                if let Some(list) = self.obstacles.as_mut() {
                     list[i] = o;
                 }
             }
@@ -645,6 +673,63 @@ mod tests {
             assert!((polygon_area(&points).abs() - 5.0 * 0.25).abs() < 1e-12);
             assert!(near(polygon_centroid(&points), (1.1, 1.1)));
         }
+    }
+
+    #[test]
+    fn set_takes_some_and_none_as_a_world_file_does() {
+        let mut spec = parse_str("(swarm: (agents: 50), mapping: (windows: 3))", "t.ron").unwrap();
+        spec.set("swarm.agents", "Some(10)").unwrap();
+        assert_eq!(spec.swarm.as_ref().unwrap().agents, Some(10));
+        spec.set("arena", "Some((width: 20.0))").unwrap();
+        assert_eq!(spec.arena.as_ref().unwrap().width, Some(20.0));
+        // `None` clears a setting, which then takes its default.
+        spec.set("swarm.agents", "None").unwrap();
+        assert_eq!(spec.swarm.as_ref().unwrap().agents, None);
+        spec.set("mapping", "None").unwrap();
+        assert_eq!(spec.mapping, None);
+        match spec.set("swarm.agents", "Some(ten)") {
+            Err(WorldError::BadSetting { message, .. }) => {
+                assert!(message.contains("does not parse"), "{message}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_name_is_a_bare_word_or_a_whole_string() {
+        let mut spec = WorldSpec::default();
+        spec.set("name", "lab-7").unwrap();
+        assert_eq!(spec.name.as_deref(), Some("lab-7"));
+        spec.set("name", "\"two words\"").unwrap();
+        assert_eq!(spec.name.as_deref(), Some("two words"));
+        spec.set("name", "None").unwrap();
+        assert_eq!(spec.name.as_deref(), Some("None"));
+        for bad in ["\"abc", "\"a\" b", "r\"x"] {
+            match spec.set("name", bad) {
+                Err(WorldError::BadSetting { message, .. }) => {
+                    assert!(message.contains("close the quote"), "{bad}: {message}")
+                }
+                other => panic!("{bad}: {other:?}"),
+            }
+            assert_eq!(spec.name.as_deref(), Some("None"), "{bad}");
+        }
+    }
+
+    #[test]
+    fn an_obstacle_cannot_be_set_to_none() {
+        let mut spec = parse_str(
+            "(obstacles: [Circle(center: (2.0, 2.0), radius: 0.5)])",
+            "t.ron",
+        )
+        .unwrap();
+        let before = spec.obstacles.clone();
+        match spec.set("obstacles[0]", "None") {
+            Err(WorldError::BadSetting { message, .. }) => {
+                assert!(message.contains("obstacles=[]"), "{message}")
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(spec.obstacles, before);
     }
 
     #[test]
