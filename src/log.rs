@@ -196,7 +196,7 @@ impl CsvFile {
                     message: format!(
                         "missing column `{r}`; the header must contain {} (found: {})",
                         required.join(","),
-                        headers.iter().collect::<Vec<_>>().join(",")
+                        shown(&headers.iter().collect::<Vec<_>>().join(","))
                     ),
                 });
             }
@@ -269,12 +269,13 @@ struct Row<'a> {
     columns: &'a Columns,
 }
 
-/// A cell as an error message shows it: control characters (a NUL byte, a tab) escaped,
-/// so that a message shows what the file holds.
+/// A cell as an error message shows it: control characters (a NUL byte, a tab) and the
+/// backslash escaped as Rust writes them (`\0`, `\t`, `\\`), so that a message shows what
+/// the file holds and a NUL byte cannot be mistaken for the text `\0`.
 pub(crate) fn shown(cell: &str) -> String {
     let mut out = String::with_capacity(cell.len());
     for c in cell.chars() {
-        if c.is_control() {
+        if c.is_control() || c == '\\' {
             out.extend(c.escape_debug());
         } else {
             out.push(c);
@@ -581,6 +582,12 @@ mod tests {
         let e = error_of("start,end,a,b\n0,1\0,4,5\n");
         assert!(
             e.contains(":2: column `end` is `1\\0`, which is not a number"),
+            "{e}"
+        );
+        // The text `1\0` (a backslash and a zero) is not shown as a NUL byte would be.
+        let e = error_of("start,end,a,b\n0,1\\0,4,5\n");
+        assert!(
+            e.contains(":2: column `end` is `1\\\\0`, which is not a number"),
             "{e}"
         );
         let d = tempfile::tempdir().unwrap();

@@ -399,7 +399,14 @@ fn an_empty_or_sample_free_trajectories_file_is_named_as_such() {
         .code(2)
         .stderr(contains("trajectories.csv: the file is empty").and(contains("delete it")));
     fs::write(run.join("trajectories.csv"), "time,agent,x,y,state\n").unwrap();
-    swarmmap().arg("report").arg(&run).assert().success();
+    swarmmap()
+        .arg("report")
+        .arg(&run)
+        .assert()
+        .success()
+        .stdout(contains(
+            "replay unavailable: trajectories.csv holds no samples",
+        ));
     let html = fs::read_to_string(run.join("report/index.html")).unwrap();
     assert!(
         html.contains("<code>trajectories.csv</code> holds no samples"),
@@ -430,6 +437,12 @@ fn set_accepts_some_and_none_and_refuses_a_half_quoted_name() {
         .assert()
         .success()
         .stdout(contains("12 agents"));
+    // `None` clears a setting: the default swarm of 100 agents.
+    swarmmap()
+        .args(["check", TINY, "--set", "swarm.agents=None"])
+        .assert()
+        .success()
+        .stdout(contains("100 agents"));
     swarmmap()
         .args(["check", TINY, "--set", "name=\"abc"])
         .assert()

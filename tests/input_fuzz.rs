@@ -641,12 +641,12 @@ struct Expected {
     needles: Vec<String>,
 }
 
-/// A cell as the documented messages show it: control characters as Rust escapes them
-/// (`\0`, `\t`, `\u{1b}`), everything else as it is.
+/// A cell as the documented messages show it: control characters and the backslash as
+/// Rust escapes them (`\0`, `\t`, `\u{1b}`, `\\`), everything else as it is.
 fn shown(s: &str) -> String {
     s.chars()
         .map(|c| {
-            if c.is_control() {
+            if c.is_control() || c == '\\' {
                 c.escape_debug().to_string()
             } else {
                 c.to_string()

@@ -38,6 +38,8 @@ pub fn describe(w: &swarmmap::report::Written) -> String {
         w.figures,
         if w.replay {
             "with replay"
+        } else if w.trajectories {
+            "replay unavailable: trajectories.csv holds no samples"
         } else {
             "replay unavailable: no trajectories.csv"
         }

@@ -78,6 +78,9 @@ pub struct Report {
     pub figures: Vec<Figure>,
     /// Whether the page has a replay (the run recorded trajectories).
     pub replay: bool,
+    /// Whether the run directory has a `trajectories.csv` (without a replay: one that
+    /// holds no sample).
+    pub trajectories: bool,
     /// The text of `index.html`.
     pub html: String,
 }
@@ -90,6 +93,7 @@ pub fn render(run: &RunData) -> Result<Report, ReportError> {
     Ok(Report {
         figures,
         replay: replay.is_some(),
+        trajectories: run.trajectories.is_some(),
         html,
     })
 }
@@ -103,6 +107,8 @@ pub struct Written {
     pub bytes: usize,
     pub figures: usize,
     pub replay: bool,
+    /// Whether the run directory has a `trajectories.csv`.
+    pub trajectories: bool,
 }
 
 /// Reads a run directory and writes `report/*.svg` and `report/index.html` into it (the page
@@ -133,6 +139,7 @@ pub fn write_report(dir: &Path) -> Result<Written, ReportError> {
         bytes: report.html.len(),
         figures: report.figures.len(),
         replay: report.replay,
+        trajectories: report.trajectories,
     })
 }
 

@@ -67,6 +67,10 @@ pub struct CellBlock {
 /// once and each edge is measured only on the cells near its own bounding box:
 /// O(rows · vertices + cells + Σ edges' box cells) instead of O(cells · vertices), which
 /// matters for polygons of hundreds of vertices (a floor plan, a traced outline).
+///
+/// "Bit for bit" assumes what a checked world guarantees: finite vertices whose distance
+/// formula rounds by far less than a cell. (With a vertex at 1e17 m, the rounding of
+/// `segment_distance` alone exceeds a cell, and the cells near that edge may differ.)
 pub fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mut [bool]) {
     let CellBlock {
         cols: (i0, i1),
@@ -104,7 +108,11 @@ pub fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free:
         for k in 0..n {
             let (a, b) = (points[k], points[(k + 1) % n]);
             if (a.1 > py) != (b.1 > py) {
-                crossings.push(a.0 + (py - a.1) / (b.1 - a.1) * (b.0 - a.0));
+                let x = a.0 + (py - a.1) / (b.1 - a.1) * (b.0 - a.0);
+                // `p.0 < NaN` is false: the per-point test never counts such a crossing.
+                if !x.is_nan() {
+                    crossings.push(x);
+                }
             }
         }
         if crossings.is_empty() {

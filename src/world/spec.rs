@@ -375,10 +375,13 @@ impl WorldSpec {
         let v = value.trim();
         match p {
             "name" => {
-                // A bare word is a name too; a quoted one must be a whole RON string.
-                match ron_options().from_str::<String>(v) {
-                    Ok(name) => self.name = Some(name),
-                    Err(e) if v.starts_with('"') || v.starts_with("r\"") || v.starts_with("r#") => {
+                // As the other settings (`None` clears it: the file's stem; `Some("x")`), and
+                // a bare word is a name too; a quoted one must be a whole RON string.
+                let quoted = v.starts_with('"')
+                    || (v.starts_with('r') && v[1..].trim_start_matches('#').starts_with('"'));
+                match ron_options().from_str::<Option<String>>(v) {
+                    Ok(name) => self.name = name,
+                    Err(e) if quoted => {
                         return Err(WorldError::BadSetting {
                             path: path.to_string(),
                             value: value.to_string(),
@@ -579,7 +582,6 @@ mod tests {
             // A value of the wrong shape must fail as a bad value, never as an unknown path.
             match spec.set(path, "\"definitely not valid\" )") {
                 Err(WorldError::BadSetting { .. }) => {}
-                Ok(()) if *path == "name" => {}
                 other => panic!("{path}: {other:?}"),
             }
         }
@@ -702,9 +704,13 @@ mod tests {
         assert_eq!(spec.name.as_deref(), Some("lab-7"));
         spec.set("name", "\"two words\"").unwrap();
         assert_eq!(spec.name.as_deref(), Some("two words"));
-        spec.set("name", "None").unwrap();
+        spec.set("name", "Some(\"lab 8\")").unwrap();
+        assert_eq!(spec.name.as_deref(), Some("lab 8"));
+        spec.set("name", "r#1").unwrap();
+        assert_eq!(spec.name.as_deref(), Some("r#1"));
+        spec.set("name", "\"None\"").unwrap();
         assert_eq!(spec.name.as_deref(), Some("None"));
-        for bad in ["\"abc", "\"a\" b", "r\"x"] {
+        for bad in ["\"abc", "\"a\" b", "r\"x", "r#\"x"] {
             match spec.set("name", bad) {
                 Err(WorldError::BadSetting { message, .. }) => {
                     assert!(message.contains("close the quote"), "{bad}: {message}")
@@ -713,6 +719,9 @@ mod tests {
             }
             assert_eq!(spec.name.as_deref(), Some("None"), "{bad}");
         }
+        // `None` clears it, as any setting: the world is then named after its file.
+        spec.set("name", "None").unwrap();
+        assert_eq!(spec.name, None);
     }
 
     #[test]
