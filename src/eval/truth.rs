@@ -67,7 +67,7 @@
 //! Cells are stored column-major, so a band is one contiguous slice. Construction rasterises
 //! each obstacle over its own bounding box: O(n_cells + Σ bbox cells) for discs,
 //! rectangles and walls; a polygon's cells take one pass of each row over its edges and
-//! each edge's distance only near that edge (`world::clear_polygon_cells`) rather than
+//! each edge's distance only near that edge (`world::clear_obstacle_cells`) rather than
 //! every edge at every cell of its box; it then labels the components of F once by flood fill (O(n_cells)); a 30 m × 10 m arena at
 //! 1 cm (3 M cells) with four obstacles takes about 0.15 s in a release build. A band query
 //! labels only the band's cells, O(band cells) with a fresh scratch buffer (so [`FreeSpace`]
@@ -76,7 +76,7 @@
 
 use thiserror::Error;
 
-use crate::world::{CellBlock, Obstacle, Placement, Vec2, World, clear_polygon_cells};
+use crate::world::{CellBlock, Placement, Vec2, World, clear_obstacle_cells};
 
 /// Default raster resolution in metres (`0.01`, i.e. 1 cm).
 pub const DEFAULT_RESOLUTION: f64 = 0.01;
@@ -226,27 +226,14 @@ impl FreeSpace {
             let Some((j0, j1)) = index_range(lo.1 - margin, hi.1 + margin, h, ny) else {
                 continue;
             };
-            if let Obstacle::Polygon { points } = obstacle {
-                let block = CellBlock {
-                    cols: (i0, i1),
-                    rows: (j0, j1),
-                    ny,
-                    cell: (h, h),
-                };
-                clear_polygon_cells(points, margin, block, &mut free);
-                continue;
-            }
-            for i in i0..=i1 {
-                let x = centre(i);
-                for j in j0..=j1 {
-                    let k = i * ny + j;
-                    if free[k] {
-                        let d = obstacle.signed_distance((x, centre(j)));
-                        // A NaN distance blocks the cell: never free by accident.
-                        free[k] = d > margin;
-                    }
-                }
-            }
+            let block = CellBlock {
+                cols: (i0, i1),
+                rows: (j0, j1),
+                ny,
+                cell: (h, h),
+            };
+            // A NaN distance blocks the cell: never free by accident.
+            clear_obstacle_cells(obstacle, margin, block, &mut free);
         }
 
         // The free cells of the placement region; R grows from them (`swept`).

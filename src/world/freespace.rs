@@ -6,13 +6,13 @@
 //! window, and grow only when the arena would need more than four million cells.
 //! Building a raster costs one exact clearance evaluation per cell and nearby obstacle
 //! (each obstacle is evaluated on its bounding box only; a polygon row by row and edge by
-//! edge, [`super::geometry::clear_polygon_cells`]);
+//! edge, [`super::geometry::clear_obstacle_cells`]);
 //! the queries are linear in the number of cells or columns. A raster approximates: gaps
 //! narrower than a cell may be missed, so it serves sanity checks and summaries, never
 //! the simulation itself.
 
-use super::geometry::{CellBlock, clear_polygon_cells};
-use super::types::{Obstacle, Vec2, World};
+use super::geometry::{CellBlock, clear_obstacle_cells};
+use super::types::{Vec2, World};
 
 /// Largest number of raster cells built for one world or one placement disc.
 const MAX_CELLS: f64 = 4e6;
@@ -82,25 +82,13 @@ impl FreeSpaceRaster {
             else {
                 continue;
             };
-            if let Obstacle::Polygon { points } = o {
-                let block = CellBlock {
-                    cols: (x0, x1),
-                    rows: (y0, y1),
-                    ny,
-                    cell: (cx, cy),
-                };
-                clear_polygon_cells(points, body, block, &mut free);
-                continue;
-            }
-            for ix in x0..=x1 {
-                let x = centre(ix, cx);
-                for iy in y0..=y1 {
-                    let k = ix * ny + iy;
-                    if free[k] {
-                        free[k] = o.signed_distance((x, centre(iy, cy))) > body;
-                    }
-                }
-            }
+            let block = CellBlock {
+                cols: (x0, x1),
+                rows: (y0, y1),
+                ny,
+                cell: (cx, cy),
+            };
+            clear_obstacle_cells(o, body, block, &mut free);
         }
         Self {
             cx,

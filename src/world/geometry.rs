@@ -59,19 +59,58 @@ pub struct CellBlock {
     pub cell: Vec2,
 }
 
-/// Clears `free[i · ny + j]` for every cell of `block` whose centre does not lie more than
-/// `margin ≥ 0` outside the polygon `points`, i.e. where
-/// `Obstacle::Polygon { points }.signed_distance(centre) > margin` fails; other cells keep
-/// their value. The cells come out as that test would leave them, bit for bit (the same
-/// crossing and distance formulas), but each row's inside test takes its edge crossings
-/// once and each edge is measured only on the cells near its own bounding box:
-/// O(rows · vertices + cells + Σ edges' box cells) instead of O(cells · vertices), which
-/// matters for polygons of hundreds of vertices (a floor plan, a traced outline).
+impl CellBlock {
+    /// Centre of column `i`, metres.
+    fn x(&self, i: usize) -> f64 {
+        (i as f64 + 0.5) * self.cell.0
+    }
+
+    /// Centre of row `j`, metres.
+    fn y(&self, j: usize) -> f64 {
+        (j as f64 + 0.5) * self.cell.1
+    }
+}
+
+/// Clears `free[i · ny + j]` for every cell of `block` whose centre `p` fails
+/// `obstacle.signed_distance(p) > margin` (a NaN distance fails too); other cells keep
+/// their value. Both rasters (the check's and the ground truth's) build their free cells
+/// with it, each obstacle on its own bounding box grown by the margin.
 ///
-/// "Bit for bit" assumes what a checked world guarantees: finite vertices whose distance
-/// formula rounds by far less than a cell. (With a vertex at 1e17 m, the rounding of
+/// A polygon with `margin ≥ 0` takes a faster path with the same result, bit for bit (the
+/// same crossing and distance formulas): each row's inside test takes its edge crossings
+/// once, and each edge is measured only on the cells near its own bounding box, so
+/// O(rows · vertices + cells + Σ edges' box cells) instead of O(cells · vertices), which
+/// matters for polygons of hundreds of vertices (a floor plan, a traced outline). "Bit for
+/// bit" assumes what a checked world guarantees: finite vertices whose distance formula
+/// rounds by far less than a cell. (With a vertex at 1e17 m, the rounding of
 /// `segment_distance` alone exceeds a cell, and the cells near that edge may differ.)
-pub fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mut [bool]) {
+pub fn clear_obstacle_cells(obstacle: &Obstacle, margin: f64, block: CellBlock, free: &mut [bool]) {
+    if let Obstacle::Polygon { points } = obstacle
+        && margin >= 0.0
+    {
+        clear_polygon_cells(points, margin, block, free);
+        return;
+    }
+    let CellBlock {
+        cols: (i0, i1),
+        rows: (j0, j1),
+        ny,
+        ..
+    } = block;
+    for i in i0..=i1 {
+        let x = block.x(i);
+        for j in j0..=j1 {
+            let c = i * ny + j;
+            if free[c] {
+                free[c] = obstacle.signed_distance((x, block.y(j))) > margin;
+            }
+        }
+    }
+}
+
+/// [`clear_obstacle_cells`]'s path for a polygon, `margin ≥ 0`: a cell is blocked when its
+/// centre is inside (even–odd, as `point_in_polygon`) or within `margin` of an edge.
+fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mut [bool]) {
     let CellBlock {
         cols: (i0, i1),
         rows: (j0, j1),
@@ -82,23 +121,8 @@ pub fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free:
     if n == 0 || i0 > i1 || j0 > j1 {
         return;
     }
-    let x = |i: usize| (i as f64 + 0.5) * cx;
-    let y = |j: usize| (j as f64 + 0.5) * cy;
-    if margin.is_nan() || margin < 0.0 {
-        // Inside cells deeper than −margin would be free: evaluate each cell.
-        let polygon = Obstacle::Polygon {
-            points: points.to_vec(),
-        };
-        for i in i0..=i1 {
-            for j in j0..=j1 {
-                let c = i * ny + j;
-                if free[c] {
-                    free[c] = polygon.signed_distance((x(i), y(j))) > margin;
-                }
-            }
-        }
-        return;
-    }
+    let x = |i: usize| block.x(i);
+    let y = |j: usize| block.y(j);
     // Inside (even–odd, as `point_in_polygon`): a centre is inside when an odd number of
     // the row's crossings lie strictly to its right.
     let mut crossings = Vec::new();
@@ -417,7 +441,10 @@ mod tests {
             // Some cells already blocked stay blocked.
             let start: Vec<bool> = (0..nx * ny).map(|_| rng.random_range(0..10) > 0).collect();
             let (mut fast, mut slow) = (start.clone(), start);
-            clear_polygon_cells(&points, margin, block, &mut fast);
+            let polygon = Obstacle::Polygon {
+                points: points.clone(),
+            };
+            clear_obstacle_cells(&polygon, margin, block, &mut fast);
             cells_one_by_one(&points, margin, block, &mut slow);
             assert_eq!(fast, slow, "case {case}");
             assert!(

@@ -22,7 +22,7 @@ pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count, short};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;
 pub use geometry::{
-    CellBlock, clear_polygon_cells, point_in_polygon, polygon_area, polygon_self_intersection,
+    CellBlock, clear_obstacle_cells, point_in_polygon, polygon_area, polygon_self_intersection,
     segment_distance, segments_intersect,
 };
 pub use locate::locate;
