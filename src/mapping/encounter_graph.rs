@@ -73,6 +73,20 @@
 //! intervals meet the static interval. docs/accuracy.md, step 25, measured the weight on
 //! landmark sites (least middle-to-middle time between sites under 0.5 m apart: −0.03 m
 //! median error, the interval gap −0.18 m).
+//!
+//! # Zero-weight groups
+//!
+//! Vertices joined by zero-weight edges (a static star and the encounters in it, a busy
+//! block of one agent's time line under the paper's weight) are at distance 0 from each
+//! other, so every shortest-path distance is the same for all of them. The graph is
+//! stored with each such group merged into one node, the zero-weight edges gone and the
+//! edges inside a group dropped. Nothing changes, bit for bit: Dijkstra's distance of a
+//! vertex is the least, over paths, of the weights added in path order, `d + 0.0 = d`
+//! exactly, and an edge inside a group only offers `d + w ≥ d` to a vertex already at
+//! `d`; rounding is monotone, so the least sum over the merged graph's paths is the same
+//! number (`merging_zero_weight_groups_keeps_every_distance_bit_for_bit` checks it against
+//! Dijkstra on the unmerged graph). In the bundled worlds' windows about a fifth of the
+//! vertices go (the landmarks' stars), and each shortest-path run is that much faster.
 
 use crate::log::{AgentId, Encounter, StaticInterval};
 use std::collections::HashMap;
@@ -86,15 +100,23 @@ pub enum Bridging {
     StaticTimeFree,
 }
 
-/// A weighted undirected graph in compressed sparse row form. Vertices `0..encounters`
-/// are encounters (in the order given); with a switch cost, `encounters..2 · encounters`
-/// are their second halves (agent `b`'s side; vertex `i` is then agent `a`'s side); the
-/// rest are virtual static-interval vertices.
+/// A weighted undirected graph in compressed sparse row form, built on the vertices
+/// `0..encounters` (encounters in the order given), with a switch cost
+/// `encounters..2 · encounters` (their second halves: agent `b`'s side; vertex `i` is then
+/// agent `a`'s side), then virtual static-interval vertices; stored with every set of
+/// vertices joined by zero-weight edges merged into one node (module docs, "Zero-weight
+/// groups").
 #[derive(Debug, Clone)]
 pub struct EncounterGraph {
     encounters: usize,
     /// Whether every encounter is split into two halves joined by the switch cost.
     halves: bool,
+    /// The node of each encounter vertex (`encounters` or `2 · encounters` of them).
+    node_of: Vec<u32>,
+    /// The encounters with a vertex in each node, ascending: node `u` holds
+    /// `members[member_offsets[u]..member_offsets[u + 1]]`.
+    member_offsets: Vec<usize>,
+    members: Vec<u32>,
     offsets: Vec<usize>,
     targets: Vec<u32>,
     weights: Vec<f64>,
@@ -140,6 +162,21 @@ impl EncounterGraph {
         switch: f64,
         midpoints: bool,
     ) -> Self {
+        let (halves, vertices, edges) =
+            Self::timed_edges(encounters, statics, bridging, switch, midpoints);
+        Self::from_edges(encounters.len(), halves, vertices, &edges)
+    }
+
+    /// The vertices and edges of [`Self::build_timed`]'s graph before zero-weight groups are
+    /// merged: whether encounters are split into halves, the number of vertices, and the
+    /// edges `(u, v, weight)`.
+    fn timed_edges(
+        encounters: &[Encounter],
+        statics: &[StaticInterval],
+        bridging: Bridging,
+        switch: f64,
+        midpoints: bool,
+    ) -> (bool, usize, Vec<(u32, u32, f64)>) {
         let n = encounters.len();
         let halves = switch.is_finite() && switch > 0.0;
         let mut lines: HashMap<AgentId, Vec<Item>> = HashMap::new();
@@ -214,7 +251,7 @@ impl EncounterGraph {
                 }
             }
         }
-        Self::from_edges(n, halves, next_vertex as usize, &edges)
+        (halves, next_vertex as usize, edges)
     }
 
     fn from_edges(
@@ -223,29 +260,98 @@ impl EncounterGraph {
         vertices: usize,
         edges: &[(u32, u32, f64)],
     ) -> Self {
-        let mut degree = vec![0usize; vertices + 1];
-        for &(a, b, _) in edges {
-            degree[a as usize + 1] += 1;
-            degree[b as usize + 1] += 1;
+        // Merge the vertices joined by zero-weight edges (union-find with path halving);
+        // nodes are numbered in the order of their first vertex, so the layout follows the
+        // vertices' and is deterministic.
+        let mut parent: Vec<u32> = (0..vertices as u32).collect();
+        let find = |parent: &mut [u32], mut x: u32| {
+            while parent[x as usize] != x {
+                parent[x as usize] = parent[parent[x as usize] as usize];
+                x = parent[x as usize];
+            }
+            x
+        };
+        for &(a, b, w) in edges {
+            if w == 0.0 {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                if ra != rb {
+                    parent[ra.max(rb) as usize] = ra.min(rb);
+                }
+            }
         }
-        for i in 0..vertices {
+        let mut node = vec![u32::MAX; vertices];
+        let mut nodes = 0u32;
+        for v in 0..vertices as u32 {
+            let r = find(&mut parent, v);
+            if node[r as usize] == u32::MAX {
+                node[r as usize] = nodes;
+                nodes += 1;
+            }
+            node[v as usize] = node[r as usize];
+        }
+        let nodes = nodes as usize;
+        // The remaining edges between distinct nodes, in compressed sparse row form.
+        let kept = || {
+            edges.iter().filter_map(|&(a, b, w)| {
+                let (x, y) = (node[a as usize], node[b as usize]);
+                (w != 0.0 && x != y).then_some((x, y, w))
+            })
+        };
+        let mut degree = vec![0usize; nodes + 1];
+        for (x, y, _) in kept() {
+            degree[x as usize + 1] += 1;
+            degree[y as usize + 1] += 1;
+        }
+        for i in 0..nodes {
             degree[i + 1] += degree[i];
         }
         let offsets = degree;
         let mut fill = offsets.clone();
-        let mut targets = vec![0u32; offsets[vertices]];
-        let mut weights = vec![0f64; offsets[vertices]];
-        for &(a, b, w) in edges {
-            for (x, y) in [(a, b), (b, a)] {
-                let k = fill[x as usize];
-                targets[k] = y;
+        let mut targets = vec![0u32; offsets[nodes]];
+        let mut weights = vec![0f64; offsets[nodes]];
+        for (x, y, w) in kept() {
+            for (p, q) in [(x, y), (y, x)] {
+                let k = fill[p as usize];
+                targets[k] = q;
                 weights[k] = w;
-                fill[x as usize] += 1;
+                fill[p as usize] += 1;
+            }
+        }
+        let encounter_vertices = if halves { 2 * encounters } else { encounters };
+        let node_of = node[..encounter_vertices].to_vec();
+        // Each node's encounters, ascending, each once (an encounter's two halves may share
+        // a node).
+        let mut count = vec![0usize; nodes + 1];
+        let of_encounter = |i: usize| {
+            let first = node_of[i];
+            let second = halves.then(|| node_of[encounters + i]);
+            (first, second.filter(|&s| s != first))
+        };
+        for i in 0..encounters {
+            let (first, second) = of_encounter(i);
+            for u in std::iter::once(first).chain(second) {
+                count[u as usize + 1] += 1;
+            }
+        }
+        for u in 0..nodes {
+            count[u + 1] += count[u];
+        }
+        let member_offsets = count;
+        let mut fill = member_offsets.clone();
+        let mut members = vec![0u32; member_offsets[nodes]];
+        for i in 0..encounters {
+            let (first, second) = of_encounter(i);
+            for u in std::iter::once(first).chain(second) {
+                members[fill[u as usize]] = i as u32;
+                fill[u as usize] += 1;
             }
         }
         Self {
             encounters,
             halves,
+            node_of,
+            member_offsets,
+            members,
             offsets,
             targets,
             weights,
@@ -257,12 +363,13 @@ impl EncounterGraph {
         self.encounters
     }
 
-    /// Number of vertices, encounter halves and virtual static vertices included.
+    /// Number of nodes: the vertices (encounter halves and virtual static vertices
+    /// included) once those joined by zero-weight edges are merged.
     pub fn vertices(&self) -> usize {
         self.offsets.len() - 1
     }
 
-    /// Number of undirected edges.
+    /// Number of undirected edges between distinct nodes (zero-weight edges merged away).
     pub fn edges(&self) -> usize {
         self.targets.len() / 2
     }
@@ -274,21 +381,22 @@ impl EncounterGraph {
     /// does not depend on the order in which equal keys pop (each distance is the minimum
     /// over its neighbours' final distances), so it is deterministic.
     pub fn distances_from(&self, source: usize) -> Vec<f64> {
-        let mut dist = self.dijkstra(source, |_, _| true);
+        let dist = self.dijkstra(source, |_, _| true);
         let n = self.encounters;
         if self.halves {
-            let (a, b) = dist.split_at_mut(n);
-            for (x, &y) in a.iter_mut().zip(&b[..n]) {
-                *x = x.min(y);
-            }
+            let (a, b) = self.node_of.split_at(n);
+            a.iter()
+                .zip(b)
+                .map(|(&x, &y)| dist[x as usize].min(dist[y as usize]))
+                .collect()
+        } else {
+            self.node_of.iter().map(|&x| dist[x as usize]).collect()
         }
-        dist.truncate(n);
-        dist
     }
 
-    /// Dijkstra from encounter `source` (both halves): calls `settled(u, d)` as each vertex
+    /// Dijkstra from encounter `source` (both halves): calls `settled(u, d)` as each node
     /// `u` pops at its final distance `d`, stops as soon as that returns `false`, and returns
-    /// the distances of every vertex (final for those popped).
+    /// the distances of every node (final for those popped).
     fn dijkstra(&self, source: usize, mut settled: impl FnMut(usize, f64) -> bool) -> Vec<f64> {
         let mut dist = vec![f64::INFINITY; self.vertices()];
         let mut heap = RadixHeap::new();
@@ -296,9 +404,13 @@ impl EncounterGraph {
         // An encounter is both of its halves: either agent's side can start a path.
         let sources = [Some(source), self.halves.then_some(n + source)];
         for v in sources.into_iter().flatten() {
-            dist[v] = 0.0;
+            let u = self.node_of[v] as usize;
+            if dist[u] == 0.0 {
+                continue;
+            }
+            dist[u] = 0.0;
             // Non-negative f64 bit patterns order like the numbers, so u64 keys are exact.
-            heap.push(0f64.to_bits(), v as u32);
+            heap.push(0f64.to_bits(), u as u32);
         }
         while let Some((bits, u)) = heap.pop() {
             let d = f64::from_bits(bits);
@@ -326,21 +438,20 @@ impl EncounterGraph {
     /// an encounter's distance is final when the first of its vertices pops), and stops
     /// as soon as `visit` returns `false`.
     fn settle_from(&self, source: usize, mut visit: impl FnMut(usize, f64) -> bool) {
-        let n = self.encounters;
-        let mut reached = vec![false; n];
+        let mut reached = vec![false; self.encounters];
         self.dijkstra(source, |u, d| {
-            let encounter = if u < n {
-                u
-            } else if self.halves && u < 2 * n {
-                u - n
-            } else {
-                return true;
-            };
-            if reached[encounter] {
-                return true;
+            let held = &self.members[self.member_offsets[u]..self.member_offsets[u + 1]];
+            for &encounter in held {
+                let encounter = encounter as usize;
+                if reached[encounter] {
+                    continue;
+                }
+                reached[encounter] = true;
+                if !visit(encounter, d) {
+                    return false;
+                }
             }
-            reached[encounter] = true;
-            visit(encounter, d)
+            true
         });
     }
 
@@ -424,8 +535,9 @@ impl EncounterGraph {
         }
         // Renumber by first appearance among encounter vertices only.
         let mut map = HashMap::new();
-        label[..self.encounters]
+        self.node_of[..self.encounters]
             .iter()
+            .map(|&u| &label[u as usize])
             .map(|l| {
                 let k = map.len();
                 *map.entry(*l).or_insert(k)
@@ -851,6 +963,93 @@ mod tests {
         assert_eq!(paper.distances_from(0)[1], 59.0);
         let free = EncounterGraph::build(&enc, &st, Bridging::StaticTimeFree);
         assert_eq!(free.distances_from(0)[1], 10.0);
+    }
+
+    /// Dijkstra on the graph as built, before zero-weight groups are merged (a binary heap
+    /// over every vertex): each encounter's distance, the smaller over its halves.
+    fn unmerged_distances(
+        n: usize,
+        (halves, vertices, edges): &(bool, usize, Vec<(u32, u32, f64)>),
+        source: usize,
+    ) -> Vec<f64> {
+        use std::cmp::Reverse;
+        let mut adjacency = vec![Vec::new(); *vertices];
+        for &(a, b, w) in edges {
+            adjacency[a as usize].push((b as usize, w));
+            adjacency[b as usize].push((a as usize, w));
+        }
+        let mut dist = vec![f64::INFINITY; *vertices];
+        let mut heap = std::collections::BinaryHeap::new();
+        for v in [Some(source), halves.then_some(n + source)]
+            .into_iter()
+            .flatten()
+        {
+            dist[v] = 0.0;
+            heap.push(Reverse((0f64.to_bits(), v)));
+        }
+        while let Some(Reverse((bits, u))) = heap.pop() {
+            let d = f64::from_bits(bits);
+            if d > dist[u] {
+                continue;
+            }
+            for &(v, w) in &adjacency[u] {
+                if d + w < dist[v] {
+                    dist[v] = d + w;
+                    heap.push(Reverse(((d + w).to_bits(), v)));
+                }
+            }
+        }
+        (0..n)
+            .map(|i| match halves {
+                true => dist[i].min(dist[n + i]),
+                false => dist[i],
+            })
+            .collect()
+    }
+
+    /// Merging the vertices joined by zero-weight edges changes no distance, bit for bit,
+    /// and no component, on logs full of zero-weight edges: static stars, overlapping
+    /// intervals under the paper's weight, zero-length and tied encounters, static time
+    /// made free, with and without switch costs and middles.
+    #[test]
+    fn merging_zero_weight_groups_keeps_every_distance_bit_for_bit() {
+        let mut merged_some = false;
+        for seed in 0..40 {
+            let (enc, statics) = random_log(300 + seed, 50, 7);
+            for bridging in [Bridging::Paper, Bridging::StaticTimeFree] {
+                for switch in [0.0, 1.5] {
+                    for midpoints in [false, true] {
+                        let raw = EncounterGraph::timed_edges(
+                            &enc, &statics, bridging, switch, midpoints,
+                        );
+                        let g = EncounterGraph::build_timed(
+                            &enc, &statics, bridging, switch, midpoints,
+                        );
+                        merged_some |= g.vertices() < raw.1;
+                        let label = format!("seed {seed} {bridging:?} {switch} {midpoints}");
+                        for source in 0..enc.len() {
+                            let want = unmerged_distances(enc.len(), &raw, source);
+                            let got = g.distances_from(source);
+                            let (want, got): (Vec<u64>, Vec<u64>) = (
+                                want.iter().map(|d| d.to_bits()).collect(),
+                                got.iter().map(|d| d.to_bits()).collect(),
+                            );
+                            assert_eq!(got, want, "{label}, source {source}");
+                        }
+                        // Two encounters share a component exactly when one reaches the other.
+                        let labels = g.components();
+                        let d0 = unmerged_distances(enc.len(), &raw, 0);
+                        for (j, d) in d0.iter().enumerate() {
+                            assert_eq!(labels[j] == labels[0], d.is_finite(), "{label}, {j}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            merged_some,
+            "the logs must have zero-weight groups to merge"
+        );
     }
 
     #[test]
