@@ -5,10 +5,14 @@
 //! the window's encounters from 12 500 to 100 000, reporting throughput (encounters/s):
 //! a flat throughput is linear cost. `cargo bench --bench mapping -- scaling` runs it alone.
 //!
+//! The `shortest_paths` group times the single-source runs that dominate the mapping on
+//! the graph the bundled worlds build (`cargo bench --bench mapping -- shortest_paths`).
+//!
 //! `cargo bench --bench mapping`
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use swarmmap::log::EncounterLog;
+use swarmmap::mapping::encounter_graph::{Bridging, EncounterGraph};
 use swarmmap::mapping::local::{LocalParams, local_map};
 use swarmmap::mapping::synthetic::{SyntheticParams, synthetic_log};
 use swarmmap::mapping::windows::Window;
@@ -62,5 +66,35 @@ fn scaling(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, scaling);
+/// Twenty single-source shortest-path runs on the encounter graph the bundled worlds map
+/// with (a switch cost of 1 s, encounter middles, the paper's static stars): 25 000
+/// encounters of 300 agents, 90 of them landmarks (30 %, as in the bundled worlds).
+fn shortest_paths(c: &mut Criterion) {
+    let mut g = c.benchmark_group("shortest_paths");
+    g.sample_size(10);
+    let p = SyntheticParams {
+        agents: 300,
+        landmarks: 90,
+        ..Default::default()
+    };
+    let log = synthetic_log(&p, 25_000);
+    let graph = EncounterGraph::build_timed(
+        &log.encounters,
+        &log.static_intervals,
+        Bridging::Paper,
+        1.0,
+        true,
+    );
+    let n = log.encounters.len();
+    g.bench_function("25000_encounters_20_sources", |bch| {
+        bch.iter(|| {
+            (0..20)
+                .map(|k| graph.distances_from(k * n / 20)[0])
+                .sum::<f64>()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, scaling, shortest_paths);
 criterion_main!(benches);

@@ -15,9 +15,10 @@
 //! (the agents sorted by cell, each column of three neighbouring cells found by binary
 //! search) costs O(n log n + E); each pick costs O(n) plus the pruned BFS, at most O(n + E).
 //! The selection runs at every landmark replacement (about 4 200 times in a scenario 2 run),
-//! so the grid is a sorted vector rather than a hash map: the run's landmark upkeep took
-//! 0.95–0.97 s instead of 1.15–1.40 s (`meta.json`'s `landmarks_s`, three alternating runs
-//! each), with byte-identical outputs.
+//! so the grid is a sorted vector rather than a hash map, and the distances to the landmarks
+//! already standing come from one multi-source BFS rather than one BFS per landmark
+//! (docs/speed.md, "Landmark selection": with both, the landmark upkeep of a scenario 2 run
+//! took 0.95–0.97 s instead of 1.15–1.40 s, with byte-identical outputs).
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -49,7 +50,9 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
     for (i, &p) in positions.iter().enumerate() {
         let (kx, ky) = key(p);
         for dx in -1..=1 {
-            let column = kx.saturating_add(dx);
+            let Some(column) = kx.checked_add(dx) else {
+                continue;
+            };
             let (low, high) = (
                 (column, ky.saturating_sub(1)),
                 (column, ky.saturating_add(1)),
@@ -253,6 +256,35 @@ mod tests {
                     .collect();
                 assert_eq!(graph.adjacency[i], want, "radius {radius}, agent {i}");
             }
+        }
+    }
+
+    /// One BFS from every landmark at once, and a pruned BFS from each landmark in turn,
+    /// both give each agent's hop distance to its nearest landmark (Floyd–Warshall on the
+    /// same graph), on random graphs with several components.
+    #[test]
+    fn one_multi_source_bfs_equals_a_bfs_per_source() {
+        let mut rng = ChaCha8Rng::seed_from_u64(21);
+        for _ in 0..200 {
+            let n = rng.random_range(1..80);
+            let positions: Vec<(f64, f64)> = (0..n)
+                .map(|_| (rng.random_range(0.0..8.0), rng.random_range(0.0..3.0)))
+                .collect();
+            let radius = rng.random_range(0.3..1.5);
+            let graph = build_graph(&positions, radius);
+            let d = hops(&positions, radius);
+            let sources: Vec<usize> = (0..n).filter(|_| rng.random_bool(0.2)).collect();
+            let want: Vec<u32> = (0..n)
+                .map(|i| sources.iter().map(|&s| d[i][s]).min().unwrap_or(UNREACHED))
+                .collect();
+            let mut one_by_one = vec![UNREACHED; n];
+            for &s in &sources {
+                relax_from(&graph, &mut one_by_one, s);
+            }
+            let mut at_once = vec![UNREACHED; n];
+            relax_from_all(&graph, &mut at_once, sources.iter().copied());
+            assert_eq!(at_once, want);
+            assert_eq!(one_by_one, want);
         }
     }
 
