@@ -297,55 +297,24 @@ impl EncounterGraph {
                 (w != 0.0 && x != y).then_some((x, y, w))
             })
         };
-        let mut degree = vec![0usize; nodes + 1];
-        for (x, y, _) in kept() {
-            degree[x as usize + 1] += 1;
-            degree[y as usize + 1] += 1;
-        }
-        for i in 0..nodes {
-            degree[i + 1] += degree[i];
-        }
-        let offsets = degree;
-        let mut fill = offsets.clone();
-        let mut targets = vec![0u32; offsets[nodes]];
-        let mut weights = vec![0f64; offsets[nodes]];
-        for (x, y, w) in kept() {
-            for (p, q) in [(x, y), (y, x)] {
-                let k = fill[p as usize];
-                targets[k] = q;
-                weights[k] = w;
-                fill[p as usize] += 1;
-            }
-        }
+        let (offsets, adjacent) = compressed_rows(nodes, || {
+            kept().flat_map(|(x, y, w)| [(x, (y, w)), (y, (x, w))])
+        });
+        let (targets, weights) = adjacent.into_iter().unzip();
         let encounter_vertices = if halves { 2 * encounters } else { encounters };
         let node_of = node[..encounter_vertices].to_vec();
         // Each node's encounters, ascending, each once (an encounter's two halves may share
         // a node).
-        let mut count = vec![0usize; nodes + 1];
-        let of_encounter = |i: usize| {
-            let first = node_of[i];
-            let second = halves.then(|| node_of[encounters + i]);
-            (first, second.filter(|&s| s != first))
-        };
-        for i in 0..encounters {
-            let (first, second) = of_encounter(i);
-            for u in std::iter::once(first).chain(second) {
-                count[u as usize + 1] += 1;
-            }
-        }
-        for u in 0..nodes {
-            count[u + 1] += count[u];
-        }
-        let member_offsets = count;
-        let mut fill = member_offsets.clone();
-        let mut members = vec![0u32; member_offsets[nodes]];
-        for i in 0..encounters {
-            let (first, second) = of_encounter(i);
-            for u in std::iter::once(first).chain(second) {
-                members[fill[u as usize]] = i as u32;
-                fill[u as usize] += 1;
-            }
-        }
+        let (member_offsets, members) = compressed_rows(nodes, || {
+            (0..encounters).flat_map(|i| {
+                let first = node_of[i];
+                let second = halves.then(|| node_of[encounters + i]);
+                let second = second.filter(|&s| s != first);
+                std::iter::once(first)
+                    .chain(second)
+                    .map(move |u| (u, i as u32))
+            })
+        });
         Self {
             encounters,
             halves,
@@ -544,6 +513,29 @@ impl EncounterGraph {
             })
             .collect()
     }
+}
+
+/// Compressed sparse rows: `entries` (called twice, to count and then to fill) yields
+/// `(row, value)` pairs; returns each row's start in the values (`rows + 1` offsets) and the
+/// values, each row's in the order given.
+fn compressed_rows<T: Copy + Default, I: Iterator<Item = (u32, T)>>(
+    rows: usize,
+    entries: impl Fn() -> I,
+) -> (Vec<usize>, Vec<T>) {
+    let mut offsets = vec![0usize; rows + 1];
+    for (row, _) in entries() {
+        offsets[row as usize + 1] += 1;
+    }
+    for i in 0..rows {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut values = vec![T::default(); offsets[rows]];
+    for (row, value) in entries() {
+        values[fill[row as usize]] = value;
+        fill[row as usize] += 1;
+    }
+    (offsets, values)
 }
 
 /// A monotone priority queue of `(key, vertex)` (Ahuja, Mehlhorn, Orlin & Tarjan 1990):
