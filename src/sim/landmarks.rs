@@ -12,13 +12,13 @@
 //! where distances do not improve.
 //!
 //! Complexity: building the graph on a uniform grid of cell size the communication radius
-//! (the agents sorted by cell, each column of three neighbouring cells found by binary
-//! search) costs O(n log n + E); each pick costs O(n) plus the pruned BFS, at most O(n + E).
-//! The selection runs at every landmark replacement (about 4 200 times in a scenario 2 run),
-//! so the grid is a sorted vector rather than a hash map, and the distances to the landmarks
-//! already standing come from one multi-source BFS rather than one BFS per landmark
-//! (docs/speed.md, "Landmark selection": with both, the landmark upkeep of a scenario 2 run
-//! took 0.95–0.97 s instead of 1.15–1.40 s, with byte-identical outputs).
+//! (the agents sorted by cell, each run of neighbouring cells found by binary search, each
+//! pair of agents tested once) costs O(n log n + E); each pick costs O(n) plus the pruned
+//! BFS, at most O(n + E). The selection runs at every landmark replacement (about 4 200
+//! times in a scenario 2 run), so the grid is a sorted vector rather than a hash map, and the
+//! distances to the landmarks already standing come from one multi-source BFS rather than
+//! one BFS per landmark (docs/speed.md, "Landmark selection": the landmark upkeep of a
+//! scenario 2 run took 1.15–1.40 s before, 0.68–0.73 s after, with byte-identical outputs).
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -47,28 +47,33 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
     cells.sort_unstable();
     let r2 = radius * radius;
     let mut adjacency = vec![Vec::new(); n];
-    for (i, &p) in positions.iter().enumerate() {
-        let (kx, ky) = key(p);
-        for dx in -1..=1 {
-            let Some(column) = kx.checked_add(dx) else {
-                continue;
-            };
+    // Each pair is tested once, from the earlier of its two places in `cells`: the later
+    // agents of the same cell and the cell above it (one run), and the next column's three
+    // cells (another run). The test is symmetric, (a − b)² = (b − a)² exactly.
+    for (at, &((kx, ky), i)) in cells.iter().enumerate() {
+        let p = positions[i as usize];
+        let above = (kx, ky.saturating_add(1));
+        let same_column = at + 1..cells.partition_point(|&(c, _)| c <= above);
+        let next_column = kx.checked_add(1).map_or(0..0, |column| {
             let (low, high) = (
                 (column, ky.saturating_sub(1)),
                 (column, ky.saturating_add(1)),
             );
-            let from = cells.partition_point(|&(c, _)| c < low);
-            let to = cells.partition_point(|&(c, _)| c <= high);
-            for &(_, j) in &cells[from..to] {
+            cells.partition_point(|&(c, _)| c < low)..cells.partition_point(|&(c, _)| c <= high)
+        });
+        for run in [same_column, next_column] {
+            for &(_, j) in &cells[run] {
                 let q = positions[j as usize];
-                let d2 = (p.0 - q.0).powi(2) + (p.1 - q.1).powi(2);
-                if j as usize != i && d2 <= r2 {
-                    adjacency[i].push(j);
+                if (p.0 - q.0).powi(2) + (p.1 - q.1).powi(2) <= r2 {
+                    adjacency[i as usize].push(j);
+                    adjacency[j as usize].push(i);
                 }
             }
         }
-        // Sorting makes BFS order canonical, whatever order the cells were scanned in.
-        adjacency[i].sort_unstable();
+    }
+    // Sorting makes BFS order canonical, whatever order the cells were scanned in.
+    for list in &mut adjacency {
+        list.sort_unstable();
     }
     let mut component = vec![u32::MAX; n];
     let mut component_sizes = Vec::new();
