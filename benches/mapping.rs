@@ -8,12 +8,17 @@
 //! The `shortest_paths` group times the single-source runs that dominate the mapping on
 //! the graph the bundled worlds build (`cargo bench --bench mapping -- shortest_paths`).
 //!
+//! The `maxmin_lookahead` group times farthest-point selection on that graph with and
+//! without rows guessed ahead on the spare cores (`cargo bench --bench mapping --
+//! maxmin_lookahead`; the same picks either way, `subsample::maxmin_with`).
+//!
 //! `cargo bench --bench mapping`
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use swarmmap::log::EncounterLog;
 use swarmmap::mapping::encounter_graph::{Bridging, EncounterGraph};
 use swarmmap::mapping::local::{LocalParams, local_map};
+use swarmmap::mapping::subsample::maxmin_with;
 use swarmmap::mapping::synthetic::{SyntheticParams, synthetic_log};
 use swarmmap::mapping::windows::Window;
 
@@ -96,5 +101,34 @@ fn shortest_paths(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, scaling, shortest_paths);
+/// A hundred farthest-point picks over every encounter of the `shortest_paths` graph, each
+/// needing its own single-source run, computed one after another (`lookahead_0`) or with
+/// one guessed row beside each needed one (`lookahead_1`), on criterion's rayon pool (one
+/// thread per core).
+fn maxmin_lookahead(c: &mut Criterion) {
+    let mut g = c.benchmark_group("maxmin_lookahead");
+    g.sample_size(10);
+    let p = SyntheticParams {
+        agents: 300,
+        landmarks: 90,
+        ..Default::default()
+    };
+    let log = synthetic_log(&p, 25_000);
+    let graph = EncounterGraph::build_timed(
+        &log.encounters,
+        &log.static_intervals,
+        Bridging::Paper,
+        1.0,
+        true,
+    );
+    let members: Vec<usize> = (0..log.encounters.len()).collect();
+    for lookahead in [0, 1] {
+        g.bench_function(format!("100_picks_lookahead_{lookahead}"), |bch| {
+            bch.iter(|| maxmin_with(&graph, &members, 100, lookahead).picks.len())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, scaling, shortest_paths, maxmin_lookahead);
 criterion_main!(benches);

@@ -8,7 +8,7 @@ use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
 use crate::io::{is_numbered_map, remove_stale, write_atomic};
 use crate::log::{EncounterLog, LogError};
 use crate::mapping::local::LocalMap;
-use crate::mapping::local::local_map;
+use crate::mapping::local::local_map_with;
 use crate::mapping::output::WindowSummary;
 use crate::mapping::output::{
     ConnectionSummary, GlobalSummary, Summary, connection_json, window_json,
@@ -197,6 +197,15 @@ fn connect_pair(
     )
 }
 
+/// How many guessed rows each of `windows` maps mapped at once may compute beside each
+/// row it needs ([`local_map_with`]): the current rayon pool's threads beyond one per
+/// window, shared out (`0` when the windows alone keep every thread busy). Farthest-point
+/// selection is sequential, so a window mapped alone (the last one of `swarmmap run`)
+/// would otherwise leave the other cores idle.
+fn spare_threads(windows: usize) -> usize {
+    (rayon::current_num_threads() / windows.max(1)).saturating_sub(1)
+}
+
 /// Completes the mapping of the final `log`: whatever `done` lacks is computed here
 /// (windows and consecutive pairs in parallel, collected in order, so the result depends
 /// neither on the number of threads nor on what `done` held).
@@ -217,10 +226,11 @@ fn finish(
         connections,
         free,
     } = done;
+    let lookahead = spare_threads(maps.iter().filter(|m| m.is_none()).count());
     let maps: Vec<LocalMap> = timings.time("local maps", || {
         maps.into_par_iter()
             .zip(windows)
-            .map(|(m, w)| m.unwrap_or_else(|| local_map(log, w, &cfg.local)))
+            .map(|(m, w)| m.unwrap_or_else(|| local_map_with(log, w, &cfg.local, lookahead)))
             .collect()
     });
     let connections: Vec<Connection> = timings.time("stitching", || {
@@ -520,11 +530,12 @@ fn simulate_alongside(
         let rest = |taken: &[bool], timings: &mut Timings| -> Vec<(usize, LocalMap)> {
             match &sim {
                 Ok(out) => timings.time("local maps", || {
+                    let lookahead = spare_threads(taken.iter().filter(|t| !**t).count());
                     windows
                         .par_iter()
                         .enumerate()
                         .filter(|(k, _)| !taken[*k])
-                        .map(|(k, w)| (k, local_map(&out.log, w, &cfg.local)))
+                        .map(|(k, w)| (k, local_map_with(&out.log, w, &cfg.local, lookahead)))
                         .collect()
                 }),
                 Err(_) => Vec::new(),
@@ -582,7 +593,9 @@ fn map_prefixes(
             }
             c.taken[k] = true;
         }
-        let map = busy.time("local maps", || local_map(&log, &windows[k], &cfg.local));
+        let map = busy.time("local maps", || {
+            local_map_with(&log, &windows[k], &cfg.local, spare_threads(1))
+        });
         if let Some(free) = &done.free {
             let line = busy.time("evaluation", || {
                 summarise_window(&map, &log, Some((world, free)))

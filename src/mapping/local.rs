@@ -26,7 +26,7 @@
 
 use super::classify::{Bank, Classifier, sampling_scale};
 use super::encounter_graph::{Bridging, EncounterGraph};
-use super::subsample::{SubsampleParams, subsample};
+use super::subsample::{SubsampleParams, subsample_with};
 use super::windows::Window;
 use crate::log::{Encounter, EncounterLog};
 use crate::topology::DistanceMatrix;
@@ -287,6 +287,18 @@ pub fn first_landmark_start(log: &EncounterLog, window: &Window) -> Option<f64> 
 
 /// Builds the local map of `window` from `log`.
 pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalMap {
+    local_map_with(log, window, p, 0)
+}
+
+/// [`local_map`] whose farthest-point selection computes up to `lookahead` guessed rows
+/// beside each needed one on the current rayon pool ([`super::subsample::maxmin_with`]):
+/// the same map, sooner when cores would otherwise be idle (one window mapped alone).
+pub fn local_map_with(
+    log: &EncounterLog,
+    window: &Window,
+    p: &LocalParams,
+    lookahead: usize,
+) -> LocalMap {
     let recorded_from = if p.after_landmarks {
         first_landmark_start(log, window).unwrap_or(f64::NEG_INFINITY)
     } else {
@@ -374,7 +386,7 @@ pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalM
         } else {
             members.clone()
         };
-        let sub = subsample(&graph, &candidates, &p.subsample);
+        let sub = subsample_with(&graph, &candidates, &p.subsample, lookahead);
         // Embed every member of the component from the representatives' rows.
         let rows: Vec<Vec<f64>> = sub
             .rows
