@@ -124,7 +124,11 @@ fn maxmin_lookahead(c: &mut Criterion) {
     let members: Vec<usize> = (0..log.encounters.len()).collect();
     for lookahead in [0, 1] {
         g.bench_function(format!("100_picks_lookahead_{lookahead}"), |bch| {
-            bch.iter(|| maxmin_with(&graph, &members, 100, lookahead).picks.len())
+            bch.iter(|| {
+                maxmin_with(&graph, &members, 100, &|| lookahead)
+                    .picks
+                    .len()
+            })
         });
     }
     g.finish();

@@ -21,7 +21,7 @@ use crate::world::{World, WorldError, WorldSpec};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, mpsc};
 use std::time::Instant;
 use thiserror::Error;
@@ -197,13 +197,13 @@ fn connect_pair(
     )
 }
 
-/// How many guessed rows each of `windows` maps mapped at once may compute beside each
-/// row it needs ([`local_map_with`]): the current rayon pool's threads beyond one per
-/// window, shared out (`0` when the windows alone keep every thread busy). Farthest-point
-/// selection is sequential, so a window mapped alone (the last one of `swarmmap run`)
-/// would otherwise leave the other cores idle.
-fn spare_threads(windows: usize) -> usize {
-    (rayon::current_num_threads() / windows.max(1)).saturating_sub(1)
+/// How many guessed rows each of `windows` maps still to be made on `free` threads may
+/// compute beside each row it needs ([`local_map_with`]): the threads beyond one per
+/// window, shared out (`0` while the windows alone keep every thread busy). Farthest-point
+/// selection is sequential, so the last window left (of `swarmmap map`, or of `swarmmap
+/// run` after the simulation) would otherwise leave the other cores idle.
+fn spare_threads(free: usize, windows: usize) -> usize {
+    (free / windows.max(1)).saturating_sub(1)
 }
 
 /// Completes the mapping of the final `log`: whatever `done` lacks is computed here
@@ -226,11 +226,19 @@ fn finish(
         connections,
         free,
     } = done;
-    let lookahead = spare_threads(maps.iter().filter(|m| m.is_none()).count());
+    // Windows not yet mapped: once fewer are left than threads, the rest guess rows ahead.
+    let left = AtomicUsize::new(maps.iter().filter(|m| m.is_none()).count());
+    let lookahead = || spare_threads(rayon::current_num_threads(), left.load(Ordering::Acquire));
     let maps: Vec<LocalMap> = timings.time("local maps", || {
         maps.into_par_iter()
             .zip(windows)
-            .map(|(m, w)| m.unwrap_or_else(|| local_map_with(log, w, &cfg.local, lookahead)))
+            .map(|(m, w)| {
+                m.unwrap_or_else(|| {
+                    let map = local_map_with(log, w, &cfg.local, &lookahead);
+                    left.fetch_sub(1, Ordering::AcqRel);
+                    map
+                })
+            })
             .collect()
     });
     let connections: Vec<Connection> = timings.time("stitching", || {
@@ -493,14 +501,19 @@ fn simulate_alongside(
     // claimed before the simulation can end (a worker that has stopped makes the send fail).
     let (tx, rx) = mpsc::sync_channel::<(usize, EncounterLog)>(usize::from(!lockstep));
     let waiting = AtomicUsize::new(0);
+    // Set once the worker has finished: its threads are then free for the final windows'
+    // guessed rows ([`spare_threads`]).
+    let worker_done = AtomicBool::new(false);
     std::thread::scope(|scope| {
-        let (claims, waiting) = (&claims, &waiting);
+        let (claims, waiting, worker_done) = (&claims, &waiting, &worker_done);
         let worker = scope.spawn(move || {
             let work = move || map_prefixes(rx, waiting, claims, world, cfg, stitch, windows);
-            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+            let out = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pool.install(work),
                 Err(_) => work(),
-            }
+            };
+            worker_done.store(true, Ordering::Release);
+            out
         });
         // At most one prefix waits for the worker: a cut that comes while one waits is left
         // to the final pass, so the copies stay few and memory stays bounded however many
@@ -530,12 +543,27 @@ fn simulate_alongside(
         let rest = |taken: &[bool], timings: &mut Timings| -> Vec<(usize, LocalMap)> {
             match &sim {
                 Ok(out) => timings.time("local maps", || {
-                    let lookahead = spare_threads(taken.iter().filter(|t| !**t).count());
+                    // Guesses only take the worker's threads once it has finished the window
+                    // it was mapping when the simulation ended.
+                    let left = AtomicUsize::new(taken.iter().filter(|t| !**t).count());
+                    let cores = rayon::current_num_threads();
+                    let lookahead = || {
+                        let free = if worker_done.load(Ordering::Acquire) {
+                            cores
+                        } else {
+                            cores.saturating_sub(threads)
+                        };
+                        spare_threads(free, left.load(Ordering::Acquire))
+                    };
                     windows
                         .par_iter()
                         .enumerate()
                         .filter(|(k, _)| !taken[*k])
-                        .map(|(k, w)| (k, local_map_with(&out.log, w, &cfg.local, lookahead)))
+                        .map(|(k, w)| {
+                            let map = local_map_with(&out.log, w, &cfg.local, &lookahead);
+                            left.fetch_sub(1, Ordering::AcqRel);
+                            (k, map)
+                        })
                         .collect()
                 }),
                 Err(_) => Vec::new(),
@@ -594,7 +622,9 @@ fn map_prefixes(
             c.taken[k] = true;
         }
         let map = busy.time("local maps", || {
-            local_map_with(&log, &windows[k], &cfg.local, spare_threads(1))
+            local_map_with(&log, &windows[k], &cfg.local, &|| {
+                spare_threads(rayon::current_num_threads(), 1)
+            })
         });
         if let Some(free) = &done.free {
             let line = busy.time("evaluation", || {

@@ -287,17 +287,17 @@ pub fn first_landmark_start(log: &EncounterLog, window: &Window) -> Option<f64> 
 
 /// Builds the local map of `window` from `log`.
 pub fn local_map(log: &EncounterLog, window: &Window, p: &LocalParams) -> LocalMap {
-    local_map_with(log, window, p, 0)
+    local_map_with(log, window, p, &|| 0)
 }
 
-/// [`local_map`] whose farthest-point selection computes up to `lookahead` guessed rows
+/// [`local_map`] whose farthest-point selection computes up to `lookahead()` guessed rows
 /// beside each needed one on the current rayon pool ([`super::subsample::maxmin_with`]):
 /// the same map, sooner when cores would otherwise be idle (one window mapped alone).
 pub fn local_map_with(
     log: &EncounterLog,
     window: &Window,
     p: &LocalParams,
-    lookahead: usize,
+    lookahead: &(dyn Fn() -> usize + Sync),
 ) -> LocalMap {
     let recorded_from = if p.after_landmarks {
         first_landmark_start(log, window).unwrap_or(f64::NEG_INFINITY)

@@ -55,7 +55,7 @@ impl Default for SubsampleParams {
 /// component), starting from the member farthest from `members[0]` so the start does not
 /// depend on input order artefacts.
 pub fn maxmin(graph: &EncounterGraph, members: &[usize], count: usize) -> Subsample {
-    maxmin_with(graph, members, count, 0)
+    maxmin_with(graph, members, count, &|| 0)
 }
 
 /// How many of the last picks' rows bound the distances to a guessed pick
@@ -65,8 +65,10 @@ const GUESS_ROWS: usize = 8;
 /// less likely to be picked (only one guess was measured, on two cores).
 pub const MAX_LOOKAHEAD: usize = 3;
 
-/// [`maxmin`] that also computes, beside each row it needs, the rows of the `lookahead`
-/// members most likely to be picked next, on the current rayon pool; the picks and rows
+/// [`maxmin`] that also computes, beside each row it needs, the rows of the `lookahead()`
+/// members most likely to be picked next (asked again before each row it needs, so a
+/// caller can raise it once other work has left cores idle; at most [`MAX_LOOKAHEAD`]),
+/// on the current rayon pool; the picks and rows
 /// are exactly [`maxmin`]'s (each row is the same shortest-path run, whichever thread
 /// makes it and whether or not it is used), only the wall-clock time differs.
 ///
@@ -77,15 +79,14 @@ pub const MAX_LOOKAHEAD: usize = 3;
 /// at least `min(nearest(j), max_p |d(p, j) − d(p, x)|)` over the last
 /// [`GUESS_ROWS`] picks `p`, and the member where that bound is largest is the guess (on
 /// scenario 2's windows the guess was the next pick in 85–93 % of the steps). A wrong
-/// guess costs one row's work on a core that would have been idle; with `lookahead` 0
-/// nothing is guessed.
+/// guess costs one row's work on a core that would have been idle; while `lookahead()` is
+/// 0 nothing is guessed.
 pub fn maxmin_with(
     graph: &EncounterGraph,
     members: &[usize],
     count: usize,
-    lookahead: usize,
+    lookahead: &(dyn Fn() -> usize + Sync),
 ) -> Subsample {
-    let lookahead = lookahead.min(MAX_LOOKAHEAD);
     let mut picks = Vec::new();
     let mut rows: Vec<Vec<f64>> = Vec::new();
     if members.is_empty() || count == 0 {
@@ -99,21 +100,23 @@ pub fn maxmin_with(
     while picks.len() < count.min(members.len()) {
         let row = match ahead.iter().position(|&(k, _)| members[k] == next) {
             Some(at) => ahead.swap_remove(at).1,
-            None if lookahead == 0 => graph.distances_from(next),
-            None => {
-                let guessed = guesses(members, &nearest, &rows, next, &ahead, lookahead);
-                let (row, made) = rayon::join(
-                    || graph.distances_from(next),
-                    || {
-                        guessed
-                            .into_par_iter()
-                            .map(|k| (k, graph.distances_from(members[k])))
-                            .collect::<Vec<_>>()
-                    },
-                );
-                ahead.extend(made);
-                row
-            }
+            None => match lookahead().min(MAX_LOOKAHEAD) {
+                0 => graph.distances_from(next),
+                lookahead => {
+                    let guessed = guesses(members, &nearest, &rows, next, &ahead, lookahead);
+                    let (row, made) = rayon::join(
+                        || graph.distances_from(next),
+                        || {
+                            guessed
+                                .into_par_iter()
+                                .map(|k| (k, graph.distances_from(members[k])))
+                                .collect::<Vec<_>>()
+                        },
+                    );
+                    ahead.extend(made);
+                    row
+                }
+            },
         };
         for (k, &j) in members.iter().enumerate() {
             nearest[k] = nearest[k].min(row[j]);
@@ -197,16 +200,16 @@ fn farthest(members: &[usize], row: &[f64]) -> usize {
 
 /// Density-aware subsample of one component: MaxMin candidates, outliers dropped.
 pub fn subsample(graph: &EncounterGraph, members: &[usize], p: &SubsampleParams) -> Subsample {
-    subsample_with(graph, members, p, 0)
+    subsample_with(graph, members, p, &|| 0)
 }
 
 /// [`subsample`] with [`maxmin_with`]'s `lookahead`: the same result, computed with up to
-/// `lookahead` guessed rows beside each needed one.
+/// `lookahead()` guessed rows beside each needed one.
 pub fn subsample_with(
     graph: &EncounterGraph,
     members: &[usize],
     p: &SubsampleParams,
-    lookahead: usize,
+    lookahead: &(dyn Fn() -> usize + Sync),
 ) -> Subsample {
     let want = ((p.m as f64) * p.oversample).ceil() as usize;
     let cand = maxmin_with(graph, members, want, lookahead);
@@ -332,7 +335,7 @@ mod tests {
                         .build()
                         .unwrap();
                     for lookahead in [1, 2, 5] {
-                        let got = pool.install(|| maxmin_with(&g, members, count, lookahead));
+                        let got = pool.install(|| maxmin_with(&g, members, count, &|| lookahead));
                         assert_eq!(got.picks, want.picks, "seed {seed}, lookahead {lookahead}");
                         assert_eq!(got.rows.len(), want.rows.len());
                         for (a, b) in got.rows.iter().zip(&want.rows) {
