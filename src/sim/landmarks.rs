@@ -15,10 +15,12 @@
 //! (the agents sorted by cell, each run of neighbouring cells found by binary search, each
 //! pair of agents tested once) costs O(n log n + E); each pick costs O(n) plus the pruned
 //! BFS, at most O(n + E). The selection runs at every landmark replacement (about 4 200
-//! times in a scenario 2 run), so the grid is a sorted vector rather than a hash map, and the
-//! distances to the landmarks already standing come from one multi-source BFS rather than
-//! one BFS per landmark (docs/speed.md, "Landmark selection": the landmark upkeep of a
-//! scenario 2 run took 1.15–1.40 s before, 0.68–0.73 s after, with byte-identical outputs).
+//! times in a scenario 2 run), so the grid is a sorted vector rather than a hash map, the
+//! adjacency is compressed rows (one allocation, not a list per agent), and the distances
+//! to the landmarks already standing come from one multi-source BFS rather than one BFS
+//! per landmark (docs/speed.md, "Landmark selection": the landmark upkeep of a scenario 2
+//! run took 1.15–1.40 s before, 0.68–0.73 s after, then 0.38–0.47 s with compressed rows
+//! against 0.49–0.62 s, with byte-identical outputs).
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -29,9 +31,17 @@ const UNREACHED: u32 = u32::MAX;
 
 /// The communication graph over a set of candidate agents.
 struct Graph {
-    adjacency: Vec<Vec<u32>>,
+    /// Agent `i`'s neighbours, ascending, are `targets[offsets[i]..offsets[i + 1]]`.
+    offsets: Vec<usize>,
+    targets: Vec<u32>,
     component: Vec<u32>,
     component_sizes: Vec<usize>,
+}
+
+impl Graph {
+    fn neighbours(&self, i: usize) -> &[u32] {
+        &self.targets[self.offsets[i]..self.offsets[i + 1]]
+    }
 }
 
 fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
@@ -46,7 +56,7 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
         .collect();
     cells.sort_unstable();
     let r2 = radius * radius;
-    let mut adjacency = vec![Vec::new(); n];
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
     // Each pair is tested once, from the earlier of its two places in `cells`: the later
     // agents of the same cell and the cell above it (one run), and the next column's three
     // cells (another run). The test is symmetric, (a − b)² = (b − a)² exactly.
@@ -65,16 +75,33 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
             for &(_, j) in &cells[run] {
                 let q = positions[j as usize];
                 if (p.0 - q.0).powi(2) + (p.1 - q.1).powi(2) <= r2 {
-                    adjacency[i as usize].push(j);
-                    adjacency[j as usize].push(i);
+                    pairs.push((i, j));
                 }
             }
         }
     }
-    // Sorting makes BFS order canonical, whatever order the cells were scanned in.
-    for list in &mut adjacency {
-        list.sort_unstable();
+    // Compressed rows, one allocation instead of a list per agent; sorting each row makes
+    // BFS order canonical, whatever order the cells were scanned in.
+    let mut offsets = vec![0usize; n + 1];
+    for &(i, j) in &pairs {
+        offsets[i as usize + 1] += 1;
+        offsets[j as usize + 1] += 1;
     }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets[..n].to_vec();
+    let mut targets = vec![0u32; offsets[n]];
+    for &(i, j) in &pairs {
+        targets[fill[i as usize]] = j;
+        fill[i as usize] += 1;
+        targets[fill[j as usize]] = i;
+        fill[j as usize] += 1;
+    }
+    for i in 0..n {
+        targets[offsets[i]..offsets[i + 1]].sort_unstable();
+    }
+    let adjacency = |u: usize| &targets[offsets[u]..offsets[u + 1]];
     let mut component = vec![u32::MAX; n];
     let mut component_sizes = Vec::new();
     let mut queue = VecDeque::new();
@@ -88,7 +115,7 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
         let mut size = 0;
         while let Some(u) = queue.pop_front() {
             size += 1;
-            for &w in &adjacency[u as usize] {
+            for &w in adjacency(u as usize) {
                 if component[w as usize] == u32::MAX {
                     component[w as usize] = c;
                     queue.push_back(w);
@@ -98,7 +125,8 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
         component_sizes.push(size);
     }
     Graph {
-        adjacency,
+        offsets,
+        targets,
         component,
         component_sizes,
     }
@@ -120,7 +148,7 @@ fn relax_from_all(graph: &Graph, dist: &mut [u32], sources: impl IntoIterator<It
     }
     while let Some(u) = queue.pop_front() {
         let du = dist[u as usize];
-        for &w in &graph.adjacency[u as usize] {
+        for &w in graph.neighbours(u as usize) {
             if dist[w as usize] > du + 1 {
                 dist[w as usize] = du + 1;
                 queue.push_back(w);
@@ -259,7 +287,7 @@ mod tests {
                     })
                     .map(|j| j as u32)
                     .collect();
-                assert_eq!(graph.adjacency[i], want, "radius {radius}, agent {i}");
+                assert_eq!(graph.neighbours(i), want, "radius {radius}, agent {i}");
             }
         }
     }
