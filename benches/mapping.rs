@@ -8,7 +8,7 @@
 //! The `shortest_paths` group times the single-source runs that dominate the mapping on
 //! the graph the bundled worlds build (`cargo bench --bench mapping -- shortest_paths`).
 //!
-//! The `maxmin_lookahead` group times farthest-point selection on that graph with and
+//! The `maxmin_lookahead` group times 400 farthest-point picks on that graph with and
 //! without rows guessed ahead on the spare cores (`cargo bench --bench mapping --
 //! maxmin_lookahead`; the same picks either way, `subsample::maxmin_with`).
 //!
@@ -101,10 +101,10 @@ fn shortest_paths(c: &mut Criterion) {
     g.finish();
 }
 
-/// A hundred farthest-point picks over every encounter of the `shortest_paths` graph, each
-/// needing its own single-source run, computed one after another (`lookahead_0`) or with
-/// one guessed row beside each needed one (`lookahead_1`), on criterion's rayon pool (one
-/// thread per core).
+/// Four hundred farthest-point picks (m's default) over every encounter of the
+/// `shortest_paths` graph, each needing its own single-source run, computed one after
+/// another (`lookahead_0`) or with one guessed row beside each needed one (`lookahead_1`),
+/// on criterion's rayon pool (one thread per core).
 fn maxmin_lookahead(c: &mut Criterion) {
     let mut g = c.benchmark_group("maxmin_lookahead");
     g.sample_size(10);
@@ -123,9 +123,9 @@ fn maxmin_lookahead(c: &mut Criterion) {
     );
     let members: Vec<usize> = (0..log.encounters.len()).collect();
     for lookahead in [0, 1] {
-        g.bench_function(format!("100_picks_lookahead_{lookahead}"), |bch| {
+        g.bench_function(format!("400_picks_lookahead_{lookahead}"), |bch| {
             bch.iter(|| {
-                maxmin_with(&graph, &members, 100, &|| lookahead)
+                maxmin_with(&graph, &members, 400, &|| lookahead)
                     .picks
                     .len()
             })

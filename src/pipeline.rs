@@ -226,9 +226,19 @@ fn finish(
         connections,
         free,
     } = done;
-    // Windows not yet mapped: once fewer are left than threads, the rest guess rows ahead.
+    // Windows not yet mapped: once at most half as many are left as threads, the rest guess
+    // rows ahead. Not when called on a pool's thread (a campaign's job): that pool's other
+    // threads run other jobs, so a guess would not use an idle core.
     let left = AtomicUsize::new(maps.iter().filter(|m| m.is_none()).count());
-    let lookahead = || spare_threads(rayon::current_num_threads(), left.load(Ordering::Acquire));
+    let own_pool = rayon::current_thread_index().is_none();
+    let lookahead = || {
+        let free = if own_pool {
+            rayon::current_num_threads()
+        } else {
+            0
+        };
+        spare_threads(free, left.load(Ordering::Acquire))
+    };
     let maps: Vec<LocalMap> = timings.time("local maps", || {
         maps.into_par_iter()
             .zip(windows)

@@ -554,7 +554,8 @@ struct RadixHeap {
     /// Bit `l` set when a bin of level `l` (1 + the hexadecimal digit where keys first
     /// differ from `last`; level 0: equal to `last`) holds an entry.
     levels: u32,
-    /// Bit `d` of `digits[l]` set when bin (`l`, `d`) holds an entry.
+    /// Bit `d` of `digits[l]` set when bin (`l`, `d`) holds an entry (`digits[0]` is kept in
+    /// step but never read: level 0 has the one bin of keys equal to `last`).
     digits: [u16; LEVELS],
     bins: Vec<Vec<(u64, u32)>>,
 }
@@ -695,6 +696,22 @@ mod tests {
             assert_eq!(k, oracle.pop().unwrap().0);
         }
         assert!(oracle.is_empty());
+        // The top digit's bins, and the vertices carried with their keys.
+        let mut heap = RadixHeap::new();
+        for (key, v) in [
+            (u64::MAX, 1),
+            (u64::MAX - 1, 2),
+            (1 << 63, 3),
+            (u64::MAX, 4),
+        ] {
+            heap.push(key, v);
+        }
+        assert_eq!(heap.pop(), Some((1 << 63, 3)));
+        assert_eq!(heap.pop(), Some((u64::MAX - 1, 2)));
+        let mut top = [heap.pop().unwrap(), heap.pop().unwrap()];
+        top.sort_unstable();
+        assert_eq!(top, [(u64::MAX, 1), (u64::MAX, 4)]);
+        assert_eq!(heap.pop(), None);
     }
 
     fn gap(x: &Encounter, y: &Encounter) -> f64 {

@@ -12,6 +12,10 @@
 //! from its own row (the distance to its k-th nearest encounter), drop candidates whose
 //! k-NN radius exceeds `outlier_factor` times the median, and keep the first m survivors
 //! in MaxMin order. Cost: O(oversample · m · (n + E) log n) time, O(m · n) memory.
+//!
+//! The picks are sequential (each needs the previous one's row), so when cores would
+//! otherwise sit idle, [`maxmin_with`] computes the rows of the likely next picks beside
+//! each needed one; the result is the same, bit for bit.
 
 use super::encounter_graph::EncounterGraph;
 use rayon::prelude::*;
@@ -64,6 +68,9 @@ const GUESS_ROWS: usize = 8;
 /// Most guessed rows per needed row ([`maxmin_with`]): each further guess in a chain is
 /// less likely to be picked (only one guess was measured, on two cores).
 pub const MAX_LOOKAHEAD: usize = 3;
+/// Most guessed rows kept for later ([`maxmin_with`]): a wrong guess is dropped, oldest
+/// first, so the rows kept and the search for new guesses stay small.
+const KEPT_AHEAD: usize = 2 * MAX_LOOKAHEAD;
 
 /// [`maxmin`] that also computes, beside each row it needs, the rows of the `lookahead()`
 /// members most likely to be picked next (asked again before each row it needs, so a
@@ -79,18 +86,31 @@ pub const MAX_LOOKAHEAD: usize = 3;
 /// at least `min(nearest(j), max_p |d(p, j) − d(p, x)|)` over the last
 /// [`GUESS_ROWS`] picks `p`, and the member where that bound is largest is the guess (on
 /// scenario 2's windows the guess was the next pick in 85–93 % of the steps). A wrong
-/// guess costs one row's work on a core that would have been idle; while `lookahead()` is
-/// 0 nothing is guessed.
+/// guess costs one row's work, on a core that is idle only if the caller's `lookahead`
+/// counts idle cores (the pipeline asks for none inside a campaign's pool, whose threads
+/// run other jobs); while `lookahead()` is 0 nothing is guessed. At most [`KEPT_AHEAD`]
+/// guessed rows are kept beyond the O(m · n) of the picks' rows.
 pub fn maxmin_with(
     graph: &EncounterGraph,
     members: &[usize],
     count: usize,
     lookahead: &(dyn Fn() -> usize + Sync),
 ) -> Subsample {
+    maxmin_counting(graph, members, count, lookahead).0
+}
+
+/// [`maxmin_with`], and how many guessed rows it used.
+fn maxmin_counting(
+    graph: &EncounterGraph,
+    members: &[usize],
+    count: usize,
+    lookahead: &(dyn Fn() -> usize + Sync),
+) -> (Subsample, usize) {
+    let mut used = 0;
     let mut picks = Vec::new();
     let mut rows: Vec<Vec<f64>> = Vec::new();
     if members.is_empty() || count == 0 {
-        return Subsample { picks, rows };
+        return (Subsample { picks, rows }, used);
     }
     let probe = graph.distances_from(members[0]);
     let mut next = farthest(members, &probe);
@@ -99,21 +119,25 @@ pub fn maxmin_with(
     let mut ahead: Vec<(usize, Vec<f64>)> = Vec::new();
     while picks.len() < count.min(members.len()) {
         let row = match ahead.iter().position(|&(k, _)| members[k] == next) {
-            Some(at) => ahead.swap_remove(at).1,
+            Some(at) => {
+                used += 1;
+                ahead.remove(at).1
+            }
             None => match lookahead().min(MAX_LOOKAHEAD) {
                 0 => graph.distances_from(next),
                 lookahead => {
-                    let guessed = guesses(members, &nearest, &rows, next, &ahead, lookahead);
                     let (row, made) = rayon::join(
                         || graph.distances_from(next),
                         || {
-                            guessed
+                            guesses(members, &nearest, &rows, next, &ahead, lookahead)
                                 .into_par_iter()
                                 .map(|k| (k, graph.distances_from(members[k])))
                                 .collect::<Vec<_>>()
                         },
                     );
                     ahead.extend(made);
+                    let surplus = ahead.len().saturating_sub(KEPT_AHEAD);
+                    ahead.drain(..surplus);
                     row
                 }
             },
@@ -137,7 +161,7 @@ pub fn maxmin_with(
         // A row computed ahead is kept only while its member may still be picked.
         ahead.retain(|&(k, _)| nearest[k] > 0.0);
     }
-    Subsample { picks, rows }
+    (Subsample { picks, rows }, used)
 }
 
 /// The places in `members` of up to `lookahead` members guessed to be picked after `next`
@@ -299,9 +323,11 @@ mod tests {
     }
 
     /// Guessing rows ahead changes nothing but the time: the picks and every row are
-    /// [`maxmin`]'s, bit for bit, for any lookahead and any number of threads, on logs
-    /// of the bundled worlds' graph (static landmarks, switch costs, middles), over all
-    /// encounters and over the landmark encounters only (which share their star's node).
+    /// [`maxmin`]'s, bit for bit, for one to [`MAX_LOOKAHEAD`] guesses and any number of
+    /// threads, on logs of the bundled worlds' graph (static landmarks, switch costs,
+    /// middles), over all encounters, over the landmark encounters only (which share their
+    /// star's node), and over unsorted members with duplicates; and the guessed rows are
+    /// used (the test would pass vacuously if nothing were guessed).
     #[test]
     fn rows_guessed_ahead_leave_the_picks_and_rows_unchanged() {
         use crate::mapping::synthetic::{SyntheticParams, synthetic_log};
@@ -326,23 +352,43 @@ mod tests {
                 .copied()
                 .filter(|&j| log.encounters[j].a < 12 || log.encounters[j].b < 12)
                 .collect();
-            for (members, count) in [(&all, 120), (&landmark, 400), (&all, 3)] {
+            let shuffled: Vec<usize> = (0..all.len())
+                .map(|k| (k * 7919) % all.len())
+                .chain([5, 5, 17])
+                .collect();
+            let cases = [
+                (&all, 120, true),
+                (&landmark, 400, true),
+                (&shuffled, 120, true),
+                (&all, 3, false),
+                (&all, 1, false),
+                (&vec![9], 4, false),
+            ];
+            for (members, count, guessed) in cases {
                 let want = maxmin(&g, members, count);
-                assert!(want.picks.len() >= count.min(3), "seed {seed}");
+                assert!(
+                    want.picks.len() >= count.min(members.len()).min(3),
+                    "seed {seed}"
+                );
                 for threads in [1, 2, 4] {
                     let pool = rayon::ThreadPoolBuilder::new()
                         .num_threads(threads)
                         .build()
                         .unwrap();
-                    for lookahead in [1, 2, 5] {
-                        let got = pool.install(|| maxmin_with(&g, members, count, &|| lookahead));
-                        assert_eq!(got.picks, want.picks, "seed {seed}, lookahead {lookahead}");
+                    for lookahead in 1..=MAX_LOOKAHEAD {
+                        let (got, used) =
+                            pool.install(|| maxmin_counting(&g, members, count, &|| lookahead));
+                        let at = format!("seed {seed}, {count} picks, lookahead {lookahead}");
+                        assert_eq!(got.picks, want.picks, "{at}");
                         assert_eq!(got.rows.len(), want.rows.len());
                         for (a, b) in got.rows.iter().zip(&want.rows) {
                             assert!(
                                 a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
-                                "seed {seed}, lookahead {lookahead}: a row differs"
+                                "{at}: a row differs"
                             );
+                        }
+                        if guessed {
+                            assert!(used > 0, "{at}: no guessed row was used");
                         }
                     }
                 }

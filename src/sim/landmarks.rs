@@ -16,7 +16,7 @@
 //! pair of agents tested once) costs O(n log n + E); each pick costs O(n) plus the pruned
 //! BFS, at most O(n + E). The selection runs at every landmark replacement (about 4 200
 //! times in a scenario 2 run), so the grid is a sorted vector rather than a hash map, the
-//! adjacency is compressed rows (one allocation, not a list per agent), and the distances
+//! adjacency is compressed rows (a few arrays, not a list per agent), and the distances
 //! to the landmarks already standing come from one multi-source BFS rather than one BFS
 //! per landmark (docs/speed.md, "Landmark selection": the landmark upkeep of a scenario 2
 //! run took 1.15–1.40 s before, 0.68–0.73 s after, then 0.38–0.47 s with compressed rows
@@ -80,7 +80,7 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
             }
         }
     }
-    // Compressed rows, one allocation instead of a list per agent; sorting each row makes
+    // Compressed rows, a few arrays instead of a list per agent; sorting each row makes
     // BFS order canonical, whatever order the cells were scanned in.
     let mut offsets = vec![0usize; n + 1];
     for &(i, j) in &pairs {
@@ -101,7 +101,12 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
     for i in 0..n {
         targets[offsets[i]..offsets[i + 1]].sort_unstable();
     }
-    let adjacency = |u: usize| &targets[offsets[u]..offsets[u + 1]];
+    let mut graph = Graph {
+        offsets,
+        targets,
+        component: Vec::new(),
+        component_sizes: Vec::new(),
+    };
     let mut component = vec![u32::MAX; n];
     let mut component_sizes = Vec::new();
     let mut queue = VecDeque::new();
@@ -115,7 +120,7 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
         let mut size = 0;
         while let Some(u) = queue.pop_front() {
             size += 1;
-            for &w in adjacency(u as usize) {
+            for &w in graph.neighbours(u as usize) {
                 if component[w as usize] == u32::MAX {
                     component[w as usize] = c;
                     queue.push_back(w);
@@ -124,12 +129,9 @@ fn build_graph(positions: &[(f64, f64)], radius: f64) -> Graph {
         }
         component_sizes.push(size);
     }
-    Graph {
-        offsets,
-        targets,
-        component,
-        component_sizes,
-    }
+    graph.component = component;
+    graph.component_sizes = component_sizes;
+    graph
 }
 
 /// Lowers `dist` by a BFS from `source`, visiting only vertices whose distance improves.
