@@ -71,26 +71,31 @@ fn scaling(c: &mut Criterion) {
     g.finish();
 }
 
-/// Twenty single-source shortest-path runs on the encounter graph the bundled worlds map
-/// with (a switch cost of 1 s, encounter middles, the paper's static stars): 25 000
-/// encounters of 300 agents, 90 of them landmarks (30 %, as in the bundled worlds).
-fn shortest_paths(c: &mut Criterion) {
-    let mut g = c.benchmark_group("shortest_paths");
-    g.sample_size(10);
+/// The encounter graph the bundled worlds map with (a switch cost of 1 s, encounter
+/// middles, the paper's static stars) on 25 000 synthetic encounters of 300 agents, 90 of
+/// them landmarks (30 %, as in the bundled worlds).
+fn bundled_graph() -> EncounterGraph {
     let p = SyntheticParams {
         agents: 300,
         landmarks: 90,
         ..Default::default()
     };
     let log = synthetic_log(&p, 25_000);
-    let graph = EncounterGraph::build_timed(
+    EncounterGraph::build_timed(
         &log.encounters,
         &log.static_intervals,
         Bridging::Paper,
         1.0,
         true,
-    );
-    let n = log.encounters.len();
+    )
+}
+
+/// Twenty single-source shortest-path runs on [`bundled_graph`].
+fn shortest_paths(c: &mut Criterion) {
+    let mut g = c.benchmark_group("shortest_paths");
+    g.sample_size(10);
+    let graph = bundled_graph();
+    let n = graph.encounters();
     g.bench_function("25000_encounters_20_sources", |bch| {
         bch.iter(|| {
             (0..20)
@@ -101,27 +106,15 @@ fn shortest_paths(c: &mut Criterion) {
     g.finish();
 }
 
-/// Four hundred farthest-point picks (m's default) over every encounter of the
-/// `shortest_paths` graph, each needing its own single-source run, computed one after
+/// Four hundred farthest-point picks (m's default) over every encounter of
+/// [`bundled_graph`], each needing its own single-source run, computed one after
 /// another (`lookahead_0`) or with one guessed row beside each needed one (`lookahead_1`),
 /// on criterion's rayon pool (one thread per core).
 fn maxmin_lookahead(c: &mut Criterion) {
     let mut g = c.benchmark_group("maxmin_lookahead");
     g.sample_size(10);
-    let p = SyntheticParams {
-        agents: 300,
-        landmarks: 90,
-        ..Default::default()
-    };
-    let log = synthetic_log(&p, 25_000);
-    let graph = EncounterGraph::build_timed(
-        &log.encounters,
-        &log.static_intervals,
-        Bridging::Paper,
-        1.0,
-        true,
-    );
-    let members: Vec<usize> = (0..log.encounters.len()).collect();
+    let graph = bundled_graph();
+    let members: Vec<usize> = (0..graph.encounters()).collect();
     for lookahead in [0, 1] {
         g.bench_function(format!("400_picks_lookahead_{lookahead}"), |bch| {
             bch.iter(|| {
