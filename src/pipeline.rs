@@ -326,8 +326,21 @@ fn finish(
 
 /// Writes `maps/window_<i>.json`, `maps/connections.json`, `maps/connection_<i>.json` (one
 /// per consecutive pair, named after its first window), `maps/global.json` and
-/// `summary.json` into `dir`, each atomically.
+/// `summary.json` into `dir`, each atomically. An earlier `summary.json` is removed first
+/// and the new one written last, once every map is in place and the earlier mapping's
+/// extra files are gone: a `summary.json` present means a complete set of maps that it
+/// describes, and an interrupted or failed write leaves none (`swarmmap report` then asks
+/// for the maps to be made again) rather than the old summary beside new maps.
 pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), PipelineError> {
+    let summary = dir.join("summary.json");
+    if let Err(source) = std::fs::remove_file(&summary)
+        && source.kind() != std::io::ErrorKind::NotFound
+    {
+        return Err(PipelineError::Write {
+            path: summary,
+            source,
+        });
+    }
     let written = std::cell::RefCell::new(std::collections::BTreeSet::new());
     let write = |name: String, text: String| {
         let path = dir.join(&name);
@@ -350,12 +363,11 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
     }
     write("maps/connections.json".into(), to_json(&m.connections))?;
     write("maps/global.json".into(), to_json(&m.global))?;
-    write("summary.json".into(), to_json(&m.summary))?;
     // A log mapped before with more windows left files these maps do not replace.
     let maps = dir.join("maps");
     remove_stale(&maps, &written.borrow(), is_numbered_map)
         .map_err(|source| PipelineError::Write { path: maps, source })?;
-    Ok(())
+    write("summary.json".into(), to_json(&m.summary))
 }
 
 /// Pretty JSON with a trailing newline.
@@ -449,6 +461,10 @@ pub fn run_world(
         neighbours: world.mapping.neighbours,
     };
     let windows = cfg.windows();
+    if let Some(dir) = &opts.out {
+        // Before the simulation, which may take hours: an output it cannot write is said now.
+        crate::sim::prepare_out_dir(dir)?;
+    }
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let alongside_pays = (2..=ALONGSIDE_MAX_WINDOWS).contains(&windows.len());
     let on = opts.alongside != Alongside::Off;

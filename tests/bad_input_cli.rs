@@ -203,6 +203,47 @@ fn a_new_simulation_removes_what_was_derived_from_the_old_log() {
 }
 
 #[test]
+fn a_mapping_that_fails_midway_leaves_no_summary_or_report_of_other_maps() {
+    // Found by an adversarial pass (thirty-seventh session): the new windows 1-2 were
+    // written, window 3 failed, and the old summary.json and report stayed beside them;
+    // `swarmmap report` then drew the mismatched files without a word.
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "run");
+    assert!(run.join("report/index.html").exists() && run.join("summary.json").exists());
+    fs::create_dir(run.join("maps/window_3.json")).unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .args(["--windows", "3", "--overlap", "10"])
+        .assert()
+        .code(1)
+        .stderr(contains("window_3.json"));
+    assert!(!run.join("summary.json").exists());
+    assert!(!run.join("report/index.html").exists());
+    assert!(
+        !names(&run.join("report"))
+            .iter()
+            .any(|f| f.ends_with(".svg")),
+        "old figures left"
+    );
+    swarmmap()
+        .arg("report")
+        .arg(&run)
+        .assert()
+        .code(2)
+        .stderr(contains("swarmmap map RUN_DIR"));
+    // Once the obstacle is gone the same command maps and reports again.
+    fs::remove_dir(run.join("maps/window_3.json")).unwrap();
+    swarmmap()
+        .arg("map")
+        .arg(&run)
+        .args(["--windows", "3", "--overlap", "10"])
+        .assert()
+        .success();
+    swarmmap().arg("report").arg(&run).assert().success();
+}
+
+#[test]
 fn an_output_path_that_is_a_file_is_named_once_with_the_fix() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("afile");
@@ -217,6 +258,90 @@ fn an_output_path_that_is_a_file_is_named_once_with_the_fix() {
                 .and(contains("File exists").not()),
         );
     assert_eq!(fs::read_to_string(&file).unwrap(), "x");
+}
+
+#[test]
+fn an_output_directory_that_cannot_be_written_is_refused_before_simulating() {
+    // Found by an adversarial pass (thirty-seventh session): `simulate` ran the whole
+    // simulation, then failed to write it. A sweep this slow takes minutes; the refusal
+    // must come at once (the timeout fails the test otherwise).
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("afile");
+    fs::write(&file, "x").unwrap();
+    let beneath = file.join("sub");
+    for command in ["simulate", "run"] {
+        for out in [&file, &beneath] {
+            swarmmap()
+                .args([
+                    command,
+                    TINY,
+                    "--quiet",
+                    "--set",
+                    "leader.speed=0.00005",
+                    "--out",
+                ])
+                .arg(out)
+                .timeout(std::time::Duration::from_secs(20))
+                .assert()
+                .code(1)
+                .stderr(contains(out.display().to_string()));
+        }
+    }
+    assert_eq!(names(tmp.path()), ["afile"]);
+    assert_eq!(fs::read_to_string(&file).unwrap(), "x");
+}
+
+#[test]
+fn a_campaign_refuses_the_same_run_listed_twice() {
+    // Found by an adversarial pass (thirty-seventh session): `--seeds 1,1,...` counted ten
+    // copies of one run as ten independent runs in the 95 % interval.
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("ev");
+    let dotted = format!("./{TINY}");
+    let cases: [(&[&str], &str); 5] = [
+        (&[TINY, "--seeds", "1,2,1"], "seed 1 is listed twice"),
+        (
+            &[TINY, TINY, "--seeds", "1"],
+            "is given twice; give each world once",
+        ),
+        (
+            &[TINY, &dotted, "--seeds", "1"],
+            "is given twice (also as tests/fixtures/worlds/tiny.ron)",
+        ),
+        (
+            &[TINY, "--seeds", "1", "--set", "swarm.agents=3,3"],
+            "the value 3 is listed twice",
+        ),
+        (
+            &[
+                TINY,
+                "--seeds",
+                "1",
+                "--set",
+                "swarm.agents=3",
+                "--set",
+                "swarm.agents=4",
+            ],
+            "--set swarm.agents is given twice",
+        ),
+    ];
+    for (args, says) in cases {
+        swarmmap()
+            .arg("eval")
+            .args(args)
+            .args(["--quiet", "--out"])
+            .arg(&out)
+            .assert()
+            .code(2)
+            .stderr(contains(says));
+    }
+    assert!(!out.exists(), "refused before any run");
+    swarmmap()
+        .args(["calibrate", TINY, TINY, "--seeds", "1..1", "--out"])
+        .arg(tmp.path().join("m.json"))
+        .assert()
+        .code(2)
+        .stderr(contains("is given twice"));
 }
 
 #[test]
@@ -249,6 +374,29 @@ fn calibrate_refuses_a_directory_as_its_output_before_training() {
             .stderr(contains("is a directory; give the file to write"));
         // Refused before any training run: none was kept.
         assert!(!runs.exists() || names(&runs).is_empty());
+    }
+    // A file whose directory is a file, or cannot be made: refused before training too
+    // (found by an adversarial pass, thirty-seventh session: the fit was thrown away).
+    let file = tmp.path().join("afile");
+    fs::write(&file, "x").unwrap();
+    for flag in ["--out", "--landscape"] {
+        for (target, says) in [
+            (file.join("m.json"), "is a file, not a directory"),
+            (
+                Path::new("/proc/none/m.json").to_path_buf(),
+                "cannot write /proc/none",
+            ),
+        ] {
+            swarmmap()
+                .args(["calibrate", TINY, "--seeds", "1..1", flag])
+                .arg(&target)
+                .arg("--runs")
+                .arg(&runs)
+                .assert()
+                .code(2)
+                .stderr(contains(flag).and(contains(says)));
+            assert!(!runs.exists() || names(&runs).is_empty());
+        }
     }
 }
 

@@ -112,3 +112,90 @@ fn interrupting_a_run_leaves_only_whole_files() {
         "{interrupted} interrupted ({partial} with some outputs written), {finished} finished"
     );
 }
+
+/// `swarmmap run` of seed `seed` into `out`.
+fn run_seed(out: &Path, seed: &str) -> Command {
+    let mut c = run(out);
+    c.args(["--seed", seed]);
+    c
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    for (rel, bytes) in files(from) {
+        let path = to.join(rel);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, bytes).unwrap();
+    }
+}
+
+/// The seed a whole `meta.json` or `summary.json` records.
+fn seed_of(bytes: &[u8]) -> Option<u64> {
+    serde_json::from_slice::<serde_json::Value>(bytes).ok()?["seed"].as_u64()
+}
+
+#[test]
+fn interrupting_a_run_over_an_earlier_one_never_mixes_the_two() {
+    // Found by an adversarial pass (thirty-seventh session): a run into a directory that
+    // held another run, interrupted while writing, left the new encounters beside the old
+    // meta.json and trajectories, and `swarmmap map` then judged them by the wrong world.
+    let tmp = tempfile::tempdir().unwrap();
+    let old = tmp.path().join("old");
+    assert!(run_seed(&old, "1").status().unwrap().success());
+    let new = tmp.path().join("new");
+    let t0 = Instant::now();
+    assert!(run_seed(&new, "2").status().unwrap().success());
+    let full = t0.elapsed();
+    let (old_files, new_files) = (files(&old), files(&new));
+    assert_ne!(
+        old_files.get(Path::new("encounters.csv")),
+        new_files.get(Path::new("encounters.csv"))
+    );
+
+    // Interrupt from early in the run to past its end.
+    let (mut untouched, mut mixed_checked) = (0, 0);
+    for k in 0..20u32 {
+        let out = tmp.path().join(format!("over{k}"));
+        copy_dir(&old, &out);
+        let mut child = run_seed(&out, "2").spawn().unwrap();
+        std::thread::sleep(full.mul_f64(0.1 + f64::from(k) / 20.0));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        child.wait().unwrap();
+        let got = files(&out);
+        if got == old_files {
+            // Interrupted before the new run wrote anything: the old run stands whole.
+            untouched += 1;
+            continue;
+        }
+        mixed_checked += 1;
+        for (rel, bytes) in &got {
+            let name = rel.file_name().unwrap().to_string_lossy().to_string();
+            assert!(
+                !name.ends_with(".tmp"),
+                "interrupt {k}: {rel:?} left behind"
+            );
+            let want = new_files
+                .get(rel)
+                .unwrap_or_else(|| panic!("interrupt {k}: {rel:?} is neither run's"));
+            if TIMED.contains(&name.as_str()) {
+                assert_eq!(
+                    seed_of(bytes),
+                    Some(2),
+                    "interrupt {k}: {rel:?} is the old run's"
+                );
+            } else if name == PAGE {
+                // The page shows timings; it is the new run's when the summary it was made
+                // from is.
+                let summary = got
+                    .get(Path::new("summary.json"))
+                    .unwrap_or_else(|| panic!("interrupt {k}: a report without summary.json"));
+                assert_eq!(seed_of(summary), Some(2), "interrupt {k}: old report");
+            } else {
+                assert!(bytes == want, "interrupt {k}: {rel:?} is the old run's");
+            }
+        }
+    }
+    eprintln!("{untouched} left the old run whole, {mixed_checked} held new files");
+    assert!(untouched + mixed_checked == 20);
+}

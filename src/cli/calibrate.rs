@@ -1,7 +1,7 @@
 //! `swarmmap calibrate [WORLD...] [--seeds 1..5] [--set PATH=VALUE]... [--out FILE]`: fit the
 //! robust-feature classifier on training worlds and write the model file.
 
-use super::{Failure, input, load_world};
+use super::{Failure, input, load_world, refuse_repeated_worlds};
 use anyhow::{Context, anyhow};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
@@ -214,7 +214,26 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 .display()
             )));
         }
+        // And a file that cannot be written (its directory is a file, cannot be made, or
+        // is read-only) is said now, not after the fit it would hold.
+        if let Some(p) = path {
+            let dir = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => std::path::Path::new("."),
+            };
+            if dir.exists() && !dir.is_dir() {
+                return Err(input(anyhow!(
+                    "{flag} {}: {} is a file, not a directory; give a path inside a directory",
+                    p.display(),
+                    dir.display()
+                )));
+            }
+            if let Err(e) = swarmmap::sim::prepare_out_dir(dir) {
+                return Err(input(anyhow!("{flag} {}: {e}", p.display())));
+            }
+        }
     }
+    refuse_repeated_worlds(&args.worlds)?;
     let mut paths = args.worlds.clone();
     if paths.is_empty() {
         let dir = PathBuf::from("worlds/training");

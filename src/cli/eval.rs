@@ -35,7 +35,8 @@ pub struct EvalArgs {
     pub quiet: bool,
 }
 
-/// Parses `A..B` (inclusive) or `a,b,c`.
+/// Parses `A..B` (inclusive) or `a,b,c`. A seed listed twice is refused: each seed is one
+/// independent run, and a repeated one would be counted twice in every figure and interval.
 pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
     let bad = || format!("--seeds `{s}` is not `A..B` or a list like `1,2,5`");
     if let Some((a, b)) = s.split_once("..") {
@@ -51,15 +52,24 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
         }
         Ok((a..=b).collect())
     } else {
-        s.split(',')
+        let seeds: Vec<u64> = s
+            .split(',')
             .map(|x| x.trim().parse().map_err(|_| bad()))
-            .collect()
+            .collect::<Result<_, _>>()?;
+        let mut seen = std::collections::BTreeSet::new();
+        if let Some(d) = seeds.iter().find(|&&x| !seen.insert(x)) {
+            return Err(format!(
+                "--seeds {s}: seed {d} is listed twice; each seed is one independent run, so list it once"
+            ));
+        }
+        Ok(seeds)
     }
 }
 
 pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     let seeds = parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
-    let mut sweeps = Vec::new();
+    super::refuse_repeated_worlds(&args.worlds)?;
+    let mut sweeps: Vec<(String, Vec<String>)> = Vec::new();
     for s in &args.set {
         let (path, values) = s.split_once('=').ok_or_else(|| {
             input(anyhow!(
@@ -67,7 +77,21 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
             ))
         })?;
         let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
-        sweeps.push((path.trim().to_string(), values));
+        let path = path.trim().to_string();
+        // A repeated value or field would run the same parameters twice and count them
+        // as two sets (or let the last one win unseen).
+        let mut seen = std::collections::BTreeSet::new();
+        if let Some(v) = values.iter().find(|v| !seen.insert(v.as_str())) {
+            return Err(input(anyhow!(
+                "--set `{s}`: the value {v} is listed twice; list each value once"
+            )));
+        }
+        if sweeps.iter().any(|(p, _)| *p == path) {
+            return Err(input(anyhow!(
+                "--set {path} is given twice; give its values in one --set {path}=V1,V2,..."
+            )));
+        }
+        sweeps.push((path, values));
     }
     let combos = combinations(&sweeps);
     // Validate every world × combination up front, so a typo fails at once, not per run.
@@ -140,5 +164,7 @@ mod tests {
         assert_eq!(parse_seeds("4,7").unwrap(), vec![4, 7]);
         assert!(parse_seeds("3..1").is_err());
         assert!(parse_seeds("x").is_err());
+        let twice = parse_seeds("1,2,1").unwrap_err();
+        assert!(twice.contains("seed 1 is listed twice"), "{twice}");
     }
 }

@@ -179,11 +179,20 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             input(e)
         }
     })?;
+    // A report made from the previous maps would be stale: it goes before they are
+    // replaced (an interrupted or failed write then leaves no report of other maps) and is
+    // made again from the new ones.
+    let page = args.run_dir.join("report").join("index.html");
+    let had_report = page.exists();
+    if had_report {
+        swarmmap::report::remove_report(&args.run_dir).map_err(|source| PipelineError::Write {
+            path: args.run_dir.join("report"),
+            source,
+        })?;
+    }
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
-    // A report made from the previous maps would now be stale: regenerate it.
-    let page = args.run_dir.join("report").join("index.html");
-    if page.exists() {
+    if had_report {
         swarmmap::report::write_report(&args.run_dir).map_err(super::report::failure)?;
         println!("report refreshed: {}", page.display());
     }

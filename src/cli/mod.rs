@@ -33,6 +33,27 @@ pub fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
     Failure::Input(e.into())
 }
 
+/// Refuses a world file given twice (the same file by any path): its runs would be counted
+/// twice in every figure and interval of a campaign or a fit.
+pub fn refuse_repeated_worlds(worlds: &[std::path::PathBuf]) -> Result<(), Failure> {
+    let mut seen = std::collections::BTreeMap::new();
+    for w in worlds {
+        let key = std::fs::canonicalize(w).unwrap_or_else(|_| w.clone());
+        if let Some(first) = seen.insert(key, w) {
+            let also = if first == w {
+                String::new()
+            } else {
+                format!(" (also as {})", first.display())
+            };
+            return Err(input(anyhow::anyhow!(
+                "{} is given twice{also}; give each world once",
+                w.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Loads a world file and applies `--set PATH=VALUE` overrides; any problem is an input
 /// error (status 2).
 pub fn load_world(

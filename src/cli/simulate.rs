@@ -5,7 +5,7 @@ use super::{Failure, input, load_world, progress_bar};
 use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
-use swarmmap::sim::{SimError, SimOptions, simulate, write_run};
+use swarmmap::sim::{SimError, SimOptions, prepare_out_dir, simulate, write_run};
 
 /// Options of `swarmmap simulate`.
 #[derive(Args, Debug)]
@@ -33,6 +33,9 @@ pub struct SimulateArgs {
 pub fn run(args: &SimulateArgs) -> Result<(), Failure> {
     let world = load_world(&args.world, &args.set)?;
     let seed = args.seed.unwrap_or(world.seed);
+    // Before the simulation, which may take hours: an output it cannot write is said now.
+    prepare_out_dir(&args.out)
+        .with_context(|| format!("writing the run into {}", args.out.display()))?;
     let bar = progress_bar(args.quiet, "simulating");
     let report = |f: f64| {
         if let Some(b) = &bar {

@@ -111,6 +111,19 @@ pub struct Written {
     pub trajectories: bool,
 }
 
+/// Removes the report of `dir` (`report/index.html` first, then its figures), for a caller
+/// about to replace what it was made from: a report left beside new maps or a new log would
+/// describe a run that is no longer there. Only swarmmap's own files; a missing `report/`
+/// is nothing to do.
+pub fn remove_report(dir: &Path) -> std::io::Result<()> {
+    let out = dir.join("report");
+    let none = std::collections::BTreeSet::new();
+    crate::io::remove_stale(&out, &none, |n| n == "index.html")?;
+    crate::io::remove_stale(&out, &none, |n| {
+        matches!(n, "environment.svg" | "global.svg") || crate::io::is_numbered_figure(n)
+    })
+}
+
 /// Reads a run directory and writes `report/*.svg` and `report/index.html` into it (the page
 /// last, so a complete page means a complete report).
 pub fn write_report(dir: &Path) -> Result<Written, ReportError> {

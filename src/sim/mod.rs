@@ -44,8 +44,8 @@ mod placement;
 
 pub use engine::{LEADER_INTERVAL, RETURN_ESCAPE, RETURN_NOISE, simulate};
 pub use output::{
-    encounters_csv, leader_csv, meta_json, static_intervals_csv, trajectories_csv, world_json,
-    write_run,
+    encounters_csv, leader_csv, meta_json, prepare_out_dir, static_intervals_csv, trajectories_csv,
+    world_json, write_run,
 };
 pub use params::{
     AgentState, PrefixSink, SimError, SimOptions, SimOutput, SimStats, Trajectories,

@@ -225,16 +225,18 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
     write_atomic(&path, bytes).map_err(|source| SimError::Write { path, source })
 }
 
-/// Removes what an earlier run in `dir` derived from its log, before a new log replaces it:
-/// `summary.json`, the maps (`maps/`: each window's and connection's file,
-/// `connections.json`, `global.json`), the report (`report/`: `index.html` and its
-/// figures) and, when this run records none, `trajectories.csv`. Left in place they would
-/// be read as the new log's (a report pairing the new maps with the old replay). Only
-/// when `dir` holds a swarmmap run (its `meta.json` says so: these names are common
-/// enough that a user's own directory may hold them), and only those files of
+/// Removes an earlier run in `dir` before a new log replaces it: its `meta.json` first (a
+/// complete `meta.json` means a complete run, so from then on the directory no longer
+/// claims to hold one), then what was derived from its log (`summary.json`, the maps in
+/// `maps/`: each window's and connection's file, `connections.json`, `global.json`; the
+/// report in `report/`), then the log itself (`encounters.csv`, `static_intervals.csv`,
+/// `leader.csv`, `trajectories.csv`). Left in place, an interrupted write would leave a
+/// mix: the new encounters beside the old metadata, trajectories or report, read as one
+/// run. Only when `dir` holds a swarmmap run (its `meta.json` says so: these names are
+/// common enough that a user's own directory may hold them), and only those files of
 /// swarmmap's; anything else in `dir` stays.
-fn remove_derived(dir: &Path, remove_trajectories: bool) -> std::io::Result<()> {
-    use crate::io::{is_numbered_figure, is_numbered_map, remove_stale};
+fn remove_derived(dir: &Path) -> std::io::Result<()> {
+    use crate::io::{is_numbered_map, remove_stale};
     let ours = std::fs::read(dir.join("meta.json"))
         .ok()
         .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
@@ -248,36 +250,48 @@ fn remove_derived(dir: &Path, remove_trajectories: bool) -> std::io::Result<()> 
         return Ok(());
     }
     let none = std::collections::BTreeSet::new();
-    let mut files = vec!["summary.json"];
-    if remove_trajectories {
-        files.push("trajectories.csv");
-    }
-    remove_stale(dir, &none, |n| files.contains(&n))?;
+    remove_stale(dir, &none, |n| n == "meta.json")?;
+    remove_stale(dir, &none, |n| n == "summary.json")?;
+    crate::report::remove_report(dir)?;
     remove_stale(&dir.join("maps"), &none, |n| {
         matches!(n, "connections.json" | "global.json") || is_numbered_map(n)
     })?;
-    remove_stale(&dir.join("report"), &none, |n| {
-        matches!(n, "index.html" | "environment.svg" | "global.svg") || is_numbered_figure(n)
+    remove_stale(dir, &none, |n| {
+        matches!(
+            n,
+            "encounters.csv" | "static_intervals.csv" | "leader.csv" | "trajectories.csv"
+        )
     })
+}
+
+/// Makes sure the run's files can be written into `dir` before a simulation that may take
+/// hours produces them: `dir` must be a directory (created if missing) in which a file can
+/// be created (one is, and removed at once). Nothing already in `dir` is touched.
+pub fn prepare_out_dir(dir: &Path) -> Result<(), SimError> {
+    let fail = |source| SimError::Write {
+        path: dir.to_path_buf(),
+        source,
+    };
+    if dir.exists() && !dir.is_dir() {
+        return Err(fail(std::io::Error::other(
+            "it is a file, not a directory; give --out a new or existing directory",
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    tempfile::Builder::new()
+        .prefix(".swarmmap-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(fail)
 }
 
 /// Writes the run's files into `dir` (created if missing), each atomically:
 /// `encounters.csv`, `static_intervals.csv`, `leader.csv`, `meta.json`, and
 /// `trajectories.csv` when trajectories were recorded.
 pub fn write_run(dir: &Path, world: &World, out: &SimOutput) -> Result<(), SimError> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(SimError::Write {
-            path: dir.to_path_buf(),
-            source: std::io::Error::other(
-                "it is a file, not a directory; give --out a new or existing directory",
-            ),
-        });
-    }
-    std::fs::create_dir_all(dir).map_err(|source| SimError::Write {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    remove_derived(dir, out.trajectories.is_none()).map_err(|source| SimError::Write {
+    prepare_out_dir(dir)?;
+    remove_derived(dir).map_err(|source| SimError::Write {
         path: dir.to_path_buf(),
         source,
     })?;
