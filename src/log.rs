@@ -346,11 +346,29 @@ impl Row<'_> {
     }
 }
 
+/// What reading a log noticed that is not an error but that a user should hear of.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ReadNotes {
+    /// Whether `encounters.csv`'s rows were already in the log's order (by start time,
+    /// then `a`, then `b`, each row's agents taken as `a < b`). Encounters are numbered in
+    /// that order (the maps' `encounter` indices), so only then are the numbers the file's
+    /// data rows.
+    pub encounters_in_order: bool,
+    /// Rows of `encounters.csv` that repeat an earlier row exactly (the same start, end and
+    /// agents): each is read as one more encounter.
+    pub repeated_encounters: usize,
+}
+
 impl EncounterLog {
     /// Reads a log directory: `encounters.csv` (required), `static_intervals.csv`
     /// (optional: without it no time is bridged by static agents) and `leader.csv`
     /// (optional). Truth columns `a_x,a_y,b_x,b_y` are read when all four are present.
     pub fn read_dir(dir: &Path) -> Result<Self, LogError> {
+        Self::read_dir_noting(dir).map(|(log, _)| log)
+    }
+
+    /// [`read_dir`](Self::read_dir), also saying what it noticed ([`ReadNotes`]).
+    pub fn read_dir_noting(dir: &Path) -> Result<(Self, ReadNotes), LogError> {
         let enc_path = dir.join(ENCOUNTERS_CSV);
         if !enc_path.exists() {
             return Err(LogError::Missing {
@@ -358,8 +376,9 @@ impl EncounterLog {
                 what: "encounters.csv with columns start,end,a,b",
             });
         }
+        let (encounters, notes) = read_encounters(&enc_path)?;
         let mut log = EncounterLog {
-            encounters: read_encounters(&enc_path)?,
+            encounters,
             ..Default::default()
         };
         let st = dir.join(STATIC_CSV);
@@ -370,7 +389,7 @@ impl EncounterLog {
         if le.exists() {
             log.leader = read_leader(&le)?;
         }
-        Ok(log)
+        Ok((log, notes))
     }
 
     /// Whether every encounter carries ground-truth positions.
@@ -402,7 +421,7 @@ fn interval(row: &Row<'_>) -> Result<(f64, f64), String> {
     Ok((start, end))
 }
 
-fn read_encounters(path: &Path) -> Result<Vec<Encounter>, LogError> {
+fn read_encounters(path: &Path) -> Result<(Vec<Encounter>, ReadNotes), LogError> {
     let mut f = CsvFile::open(path, &["start", "end", "a", "b"])?;
     let truth_cols = ["a_x", "a_y", "b_x", "b_y"];
     let with_truth = truth_cols.iter().all(|c| f.columns.get(c).is_some());
@@ -440,13 +459,25 @@ fn read_encounters(path: &Path) -> Result<Vec<Encounter>, LogError> {
         });
         Ok(())
     })?;
-    out.sort_by(|x, y| {
+    let order = |x: &Encounter, y: &Encounter| {
         x.start
             .total_cmp(&y.start)
             .then(x.a.cmp(&y.a))
             .then(x.b.cmp(&y.b))
-    });
-    Ok(out)
+    };
+    let encounters_in_order = out.is_sorted_by(|x, y| order(x, y).is_le());
+    let mut seen = std::collections::HashSet::with_capacity(out.len());
+    let repeated_encounters = out
+        .iter()
+        .filter(|e| !seen.insert((e.start.to_bits(), e.end.to_bits(), e.a, e.b)))
+        .count();
+    // Stable: rows equal in (start, a, b) keep the file's order.
+    out.sort_by(order);
+    let notes = ReadNotes {
+        encounters_in_order,
+        repeated_encounters,
+    };
+    Ok((out, notes))
 }
 
 fn read_static(path: &Path) -> Result<Vec<StaticInterval>, LogError> {

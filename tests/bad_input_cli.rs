@@ -433,6 +433,29 @@ fn map_warns_where_the_log_and_its_world_disagree() {
             "warning: the log names agent 100, but the world has 40 agent(s)",
         )),
     );
+    // An encounter moved to the end and repeated (found by an adversarial pass, thirty-
+    // seventh session: the maps number encounters by time, not by the file's rows, and a
+    // repeated row doubled the events silently).
+    let csv = fs::read_to_string(run.join("encounters.csv")).unwrap();
+    let mut lines: Vec<&str> = csv.lines().collect();
+    let first = lines.remove(1);
+    lines.push(first);
+    lines.push(first);
+    fs::write(run.join("encounters.csv"), lines.join("\n") + "\n").unwrap();
+    swarmmap().arg("map").arg(&run).assert().success().stderr(
+        contains("rows are not in order of start time")
+            .and(contains("1 row(s) repeating an earlier encounter")),
+    );
+    // In order and without repeats: neither warning.
+    lines.pop();
+    let last = lines.pop().unwrap();
+    lines.insert(1, last);
+    fs::write(run.join("encounters.csv"), lines.join("\n") + "\n").unwrap();
+    swarmmap().arg("map").arg(&run).assert().success().stderr(
+        contains("not in order")
+            .not()
+            .and(contains("repeating").not()),
+    );
     // A log with no encounters maps to nothing, and says so.
     fs::write(
         run.join("encounters.csv"),

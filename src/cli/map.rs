@@ -57,7 +57,7 @@ impl From<Method> for MappingMethod {
 }
 
 pub fn run(args: &MapArgs) -> Result<(), Failure> {
-    let log = EncounterLog::read_dir(&args.run_dir).map_err(input)?;
+    let (log, notes) = EncounterLog::read_dir_noting(&args.run_dir).map_err(input)?;
     let world = match &args.world {
         Some(path) => Some(load_world(path, &[])?),
         None => world_from_run(&args.run_dir).map_err(input)?,
@@ -109,10 +109,29 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
         cfg.overlap = o;
     }
+    let encounters_csv = args.run_dir.join("encounters.csv");
     if log.encounters.is_empty() {
         eprintln!(
             "warning: {} holds no encounters: every map is empty",
-            args.run_dir.join("encounters.csv").display()
+            encounters_csv.display()
+        );
+    }
+    if !notes.encounters_in_order {
+        eprintln!(
+            "warning: {}'s rows are not in order of start time (then a, then b, with a < b \
+             in each row): the maps number encounters in that order (`encounter` in \
+             maps/window_<i>.json, `points` in maps/connections.json), not by the file's \
+             rows; sort the file that way to make the numbers its data rows",
+            encounters_csv.display()
+        );
+    }
+    if notes.repeated_encounters > 0 {
+        eprintln!(
+            "warning: {} has {} row(s) repeating an earlier encounter (the same start, end \
+             and pair of agents); each is mapped as one more encounter: remove them if the \
+             file holds some rows twice",
+            encounters_csv.display(),
+            notes.repeated_encounters
         );
     }
     if let Some(w) = &world {

@@ -93,7 +93,8 @@ pub struct Summary {
 /// An event of a window as written in `window_<i>.json`.
 #[derive(Debug, Clone, Serialize)]
 struct EventOut {
-    /// Index of the encounter in `encounters.csv` order.
+    /// Number of the encounter in the log's order (by start time, then `a`, then `b`: the
+    /// row order of the `encounters.csv` swarmmap writes).
     encounter: usize,
     start: f64,
     end: f64,
@@ -160,7 +161,8 @@ pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>
 /// A point of an inter-domain cloud in `connection_<i>.json`.
 #[derive(Serialize)]
 struct CloudPointOut {
-    /// Index of the encounter in `encounters.csv` order.
+    /// Number of the encounter in the log's order (by start time, then `a`, then `b`: the
+    /// row order of the `encounters.csv` swarmmap writes).
     encounter: usize,
     start: f64,
     a: u32,
