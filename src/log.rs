@@ -188,6 +188,16 @@ impl CsvFile {
             .enumerate()
             .map(|(i, h)| (h.to_string(), i))
             .collect();
+        if headers.iter().all(str::is_empty) {
+            return Err(LogError::Csv {
+                path: path.to_path_buf(),
+                line: 1,
+                message: format!(
+                    "the file is empty; it needs a header line with the columns {} and a line per record",
+                    required.join(",")
+                ),
+            });
+        }
         for r in required {
             if !index.contains_key(*r) {
                 return Err(LogError::Csv {

@@ -345,6 +345,72 @@ fn a_campaign_refuses_the_same_run_listed_twice() {
 }
 
 #[test]
+fn smaller_findings_of_an_adversarial_pass() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = |name: &str, text: &str| {
+        let dir = tmp.path().join(name);
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("encounters.csv"), text).unwrap();
+        dir
+    };
+    // An empty file says so, not "found: " nothing.
+    let empty = log("empty", "");
+    swarmmap()
+        .arg("map")
+        .arg(&empty)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "encounters.csv:1: the file is empty; it needs a header line",
+        ));
+    // A log at one instant cannot be cut into windows (no --overlap or --windows helps).
+    let instant = log("instant", "start,end,a,b\n0,0,0,1\n0,0,1,2\n");
+    swarmmap()
+        .arg("map")
+        .arg(&instant)
+        .args(["--windows", "1", "--overlap", "0"])
+        .assert()
+        .code(2)
+        .stderr(contains("the log spans no time").and(contains("--overlap below").not()));
+    // Without truth columns no window has an oracle, not even an empty one.
+    let sparse = log("sparse", "start,end,a,b\n0,1,0,1\n1,2,1,2\n90,91,0,2\n");
+    swarmmap()
+        .arg("map")
+        .arg(&sparse)
+        .args(["--windows", "3", "--overlap", "1"])
+        .assert()
+        .success();
+    let summary: serde_json::Value =
+        serde_json::from_slice(&fs::read(sparse.join("summary.json")).unwrap()).unwrap();
+    for w in summary["windows"].as_array().unwrap() {
+        assert!(w["fidelity"]["oracle"].is_null(), "{w}");
+    }
+    // `obstacles[i]` on a world without obstacles.
+    swarmmap()
+        .args(["check", "worlds/empty.ron", "--set"])
+        .arg("obstacles[5]=Circle(center: (1.0, 1.0), radius: 0.2)")
+        .assert()
+        .code(2)
+        .stderr(contains("the world has no obstacles").and(contains("from 0 to").not()));
+    // A missing file or a directory is bad input for `persistence` too (status 2).
+    for path in [tmp.path().join("none.csv"), tmp.path().to_path_buf()] {
+        swarmmap()
+            .arg("persistence")
+            .arg(&path)
+            .assert()
+            .code(2)
+            .stderr(contains("cannot read"));
+    }
+    // A campaign directory that is a file: refused up front (status 2).
+    swarmmap()
+        .args(["eval", TINY, "--seeds", "1", "--quiet", "--out"])
+        .arg(empty.join("encounters.csv"))
+        .assert()
+        .code(2)
+        .stderr(contains("is a file, not a directory"));
+}
+
+#[test]
 fn a_world_name_cannot_lead_the_default_output_outside_runs() {
     let tmp = tempfile::tempdir().unwrap();
     let world = std::env::current_dir().unwrap().join(TINY);

@@ -69,6 +69,12 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
 pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     let seeds = parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
     super::refuse_repeated_worlds(&args.worlds)?;
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(input(anyhow!(
+            "--out {} is a file, not a directory; give the campaign a new or existing directory",
+            args.out.display()
+        )));
+    }
     let mut sweeps: Vec<(String, Vec<String>)> = Vec::new();
     for s in &args.set {
         let (path, values) = s.split_once('=').ok_or_else(|| {

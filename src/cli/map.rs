@@ -140,6 +140,15 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
     }
     let length = (cfg.span.1 - cfg.span.0) / cfg.windows as f64;
+    if cfg.span.1 <= cfg.span.0 && !log.encounters.is_empty() {
+        return Err(input(anyhow::anyhow!(
+            "{}: the log spans no time (every encounter and static interval starts and ends \
+             at {} s), so it cannot be cut into time windows; a log to map needs encounters \
+             over some time",
+            encounters_csv.display(),
+            short(cfg.span.0)
+        )));
+    }
     if cfg.overlap >= length {
         let whose = match (args.overlap, &world) {
             (Some(_), _) => "--overlap".to_string(),

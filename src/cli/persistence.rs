@@ -12,7 +12,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, anyhow};
+use anyhow::anyhow;
 use clap::Args;
 
 use super::{Failure, input};
@@ -54,8 +54,15 @@ pub fn run(args: PersistenceArgs) -> Result<(), Failure> {
     }
     .check()
     .map_err(input)?;
-    let bytes = std::fs::read(&args.file)
-        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    // A missing file or a directory is the user's input, as for every other command.
+    let bytes = std::fs::read(&args.file).map_err(|e| {
+        let what = if args.file.is_dir() {
+            "it is a directory; give the CSV file of points or distances".to_string()
+        } else {
+            e.to_string()
+        };
+        input(anyhow!("cannot read {}: {what}", args.file.display()))
+    })?;
     let rows = parse_rows(&bytes).map_err(|e| input(anyhow!("{}:{e}", args.file.display())))?;
     let diagram = if args.distance_matrix {
         let m = matrix(&rows).map_err(|e| input(located(&args.file, &rows, e)))?;

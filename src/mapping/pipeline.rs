@@ -57,6 +57,10 @@ pub fn true_position(t: &[f64; 4]) -> [f64; 2] {
 
 /// Geometric fidelity of a local map against the log's truth columns (none without them).
 pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64, rips_points: usize) -> Fidelity {
+    // A window without events has all of its (no) truth; the log must have truth at all.
+    if !log.has_truth() {
+        return Fidelity::default();
+    }
     let Some(truth) = true_positions(map, log) else {
         return Fidelity::default();
     };

@@ -439,13 +439,20 @@ impl WorldSpec {
                     });
                 }
                 let Some(i) = index.filter(|i| *i < count) else {
+                    let message = if count == 0 {
+                        "the world has no obstacles, so there is no `obstacles[i]` to change; \
+                         set the whole list instead, e.g. `obstacles=[Circle(center: (3.0, 2.0), radius: 0.5)]`"
+                            .to_string()
+                    } else {
+                        format!(
+                            "the world has {count} obstacle(s), so use `obstacles[i]` with i from 0 to {}, or set the whole `obstacles` list",
+                            count - 1
+                        )
+                    };
                     return Err(WorldError::BadSetting {
                         path: path.to_string(),
                         value: value.to_string(),
-                        message: format!(
-                            "the world has {count} obstacle(s), so use `obstacles[i]` with i from 0 to {}, or set the whole `obstacles` list",
-                            count.saturating_sub(1)
-                        ),
+                        message,
                     });
                 };
                 let mut one = None;
