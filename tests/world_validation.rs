@@ -569,7 +569,7 @@ fn time_step_must_not_skip_encounters() {
         &[
             "simulation.dt is 0.06 s",
             "more than the detection radius 0.01 m",
-            "use dt ≤ r_d / (2·speed) = 0.05 s",
+            "set simulation.dt ≤ r_d / (2·speed) = 0.05 s",
         ],
     );
     valid_with("simulation.dt", "0.05");

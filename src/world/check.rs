@@ -600,7 +600,10 @@ impl WorldSpec {
                     "is {dt} s: two agents walking at {speed} m/s towards each other close {} m per step, more than the detection radius {detection_radius} m, so encounters could be stepped over unseen",
                     short(2.0 * speed * dt)
                 ),
-                format!("use dt ≤ r_d / (2·speed) = {} s", short(detection_radius / (2.0 * speed))),
+                format!(
+                    "set simulation.dt ≤ r_d / (2·speed) = {} s (a world that sets no dt gets the default), or lower swarm.speed, or raise swarm.detection_radius",
+                    short(detection_radius / (2.0 * speed))
+                ),
             ));
         }
         let dispersion_time = ctx.non_negative(
