@@ -318,12 +318,15 @@ pub fn score(summary: &serde_json::Value) -> Score {
     s
 }
 
-fn mean(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v.iter().sum::<f64>() / v.len() as f64
-    }
+fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+/// A mean with `digits` decimals, or `none` where there is nothing to average (a run
+/// whose windows have no fidelity: no truth, or no events): an empty CSV field, `-` in the
+/// table, never `NaN`.
+fn shown_mean(v: &[f64], digits: usize, none: &str) -> String {
+    mean(v).map_or_else(|| none.to_string(), |m| format!("{m:.digits$}"))
 }
 
 /// `eval.csv`: one row per run.
@@ -336,7 +339,7 @@ pub fn csv(records: &[RunRecord]) -> String {
     for r in records {
         let s = r.summary.as_ref().map(score).unwrap_or_default();
         out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{}\n",
             r.world,
             quote(&r.params),
             r.seed,
@@ -352,8 +355,8 @@ pub fn csv(records: &[RunRecord]) -> String {
             s.global,
             s.global_truth,
             u8::from(s.global_ok),
-            mean(&s.spearman),
-            mean(&s.procrustes),
+            shown_mean(&s.spearman, 4, ""),
+            shown_mean(&s.procrustes, 4, ""),
             s.time,
             s.window_betti,
             s.window_truth,
@@ -458,7 +461,7 @@ pub fn table(records: &[RunRecord]) -> String {
     for (g, label) in groups.iter().zip(&labels.params) {
         let s = &g.sum;
         out.push_str(&format!(
-            "{:<ww$} {:<pw$} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8.2}  {:>6.3}  {:>5.1}\n",
+            "{:<ww$} {:<pw$} {:>4} {:>4}  {:>10}  {:>6}  {:>6}  {:>8}  {:>10}  {:>9}  {:>7}  {:>9}  {:>11}  {:>8}  {:>6}  {:>5.1}\n",
             g.world,
             label,
             g.runs,
@@ -472,9 +475,9 @@ pub fn table(records: &[RunRecord]) -> String {
             pct(s.connections_ok, s.connections),
             pct(g.global_ok, g.global_runs),
             pct(g.global_holes_ok, g.global_holes_runs),
-            mean(&s.spearman),
-            mean(&s.procrustes),
-            mean(&g.seconds),
+            shown_mean(&s.spearman, 2, "-"),
+            shown_mean(&s.procrustes, 3, "-"),
+            mean(&g.seconds).unwrap_or(0.0),
         ));
     }
     out.push_str(&confidence(&groups));
@@ -691,7 +694,7 @@ pub fn summary_csv(groups: &[Group]) -> String {
                 (format!("{l:.4}"), format!("{h:.4}"))
             });
         out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.3}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3}\n",
             g.world,
             quote(&g.params),
             g.runs,
@@ -714,9 +717,9 @@ pub fn summary_csv(groups: &[Group]) -> String {
             hi,
             g.global_holes_runs,
             g.global_holes_ok,
-            mean(&s.spearman),
-            mean(&s.procrustes),
-            mean(&g.seconds),
+            shown_mean(&s.spearman, 4, ""),
+            shown_mean(&s.procrustes, 4, ""),
+            mean(&g.seconds).unwrap_or(0.0),
         ));
     }
     out
@@ -892,6 +895,28 @@ mod tests {
         assert_eq!(gs[0].global_runs, 0);
         assert_eq!(confidence(&gs), "");
         assert!(summary_csv(&gs).lines().nth(1).unwrap().contains(",0,0,,,"));
+    }
+
+    #[test]
+    fn no_fidelity_is_an_empty_field_and_a_dash_not_nan() {
+        // Found by an adversarial pass (thirty-seventh session): a run whose windows had no
+        // fidelity wrote `NaN` into eval.csv and summary.csv and printed it in the table.
+        let mut r = record("w", "", 1, true);
+        r.summary = Some(serde_json::json!({
+            "windows": [{"betti": [0, 0], "truth": [1, 0], "fidelity": {}}],
+            "global": {"betti": [0, 0], "truth": [1, 0]}
+        }));
+        let rows = csv(std::slice::from_ref(&r));
+        let row = rows.lines().nth(1).unwrap();
+        assert!(!row.contains("NaN") && row.contains(",0,,,"), "{row}");
+        let gs = groups(std::slice::from_ref(&r));
+        let line = summary_csv(&gs);
+        assert!(
+            !line.contains("NaN") && line.lines().nth(1).unwrap().contains(",,,"),
+            "{line}"
+        );
+        let t = table(&[r]);
+        assert!(!t.contains("NaN") && t.contains("       -       -"), "{t}");
     }
 
     #[test]
