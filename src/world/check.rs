@@ -184,16 +184,12 @@ fn check_obstacle(
             for (j, p) in points.iter().enumerate() {
                 ctx.point(&f(&format!("points[{j}]")), *p)?;
             }
-            for j in 0..points.len() {
-                for k in 0..j {
-                    if points[j] == points[k] {
-                        return Err(ctx.err(
-                            &f(&format!("points[{j}]")),
-                            format!("repeats points[{k}] {} (vertices must be distinct)", fmt_pt(points[j])),
-                            "remove the repeated vertex; the polygon closes itself, so do not repeat the first vertex at the end",
-                        ));
-                    }
-                }
+            if let Some((j, k)) = first_repeat(points) {
+                return Err(ctx.err(
+                    &f(&format!("points[{j}]")),
+                    format!("repeats points[{k}] {} (vertices must be distinct)", fmt_pt(points[j])),
+                    "remove the repeated vertex; the polygon closes itself, so do not repeat the first vertex at the end",
+                ));
             }
             if collinear(points) {
                 return Err(ctx.err(
@@ -797,9 +793,50 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
     Ok(())
 }
 
+/// The first vertex `j` that repeats an earlier one, with the first such earlier `k`
+/// (`points[j] == points[k]`, `k < j`): what a scan of every pair in order finds, in
+/// O(n log n) by sorting (a polygon exported from a drawing can have tens of thousands
+/// of vertices).
+fn first_repeat(points: &[(f64, f64)]) -> Option<(usize, usize)> {
+    // `+ 0.0` makes -0.0 equal to 0.0 under `total_cmp`, as it is under `==`.
+    let key = |i: usize| (points[i].0 + 0.0, points[i].1 + 0.0);
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&p, &q| {
+        let (a, b) = (key(p), key(q));
+        a.0.total_cmp(&b.0)
+            .then(a.1.total_cmp(&b.1))
+            .then(p.cmp(&q))
+    });
+    // Within a run of equal points (sorted by index) the second is its first repeat.
+    order
+        .windows(2)
+        .filter(|w| key(w[0]) == key(w[1]))
+        .map(|w| (w[1], w[0]))
+        .fold(None, |best: Option<(usize, usize)>, (j, k)| match best {
+            Some((bj, _)) if bj <= j => best,
+            _ => Some((j, k)),
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// Sorting finds the repeat a scan of every pair in order finds (-0.0 = 0.0 too).
+        #[test]
+        fn first_repeat_equals_the_pairwise_scan(
+            grid in proptest::collection::vec((-2i32..3, -2i32..3), 0..12),
+        ) {
+            let points: Vec<(f64, f64)> = grid
+                .iter()
+                .map(|&(x, y)| (if x == 0 { -0.0 } else { f64::from(x) }, f64::from(y) * 0.5))
+                .collect();
+            let brute = (0..points.len())
+                .find_map(|j| (0..j).find(|&k| points[j] == points[k]).map(|k| (j, k)));
+            proptest::prop_assert_eq!(first_repeat(&points), brute);
+        }
+    }
 
     #[test]
     fn short_rounds_to_six_significant_digits() {
