@@ -228,13 +228,17 @@ pub fn polygon_centroid(poly: &[Vec2]) -> Vec2 {
 }
 
 /// Orientation of `c` relative to the directed line `a → b`: `1` left, `-1` right, `0`
-/// collinear (within a tolerance relative to the coordinates' magnitude).
+/// collinear, within a tolerance that scales with the coordinates' magnitude and with the
+/// two edges' lengths, as the cross product's rounding does: a small triangle far from the
+/// origin keeps its orientation (with a tolerance of the magnitude squared alone, a 1 µm
+/// triangle at x = 3 m was called collinear and then self-intersecting).
 fn orientation(a: Vec2, b: Vec2, c: Vec2) -> i8 {
     let cross = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
     let scale = [a.0, a.1, b.0, b.1, c.0, c.1]
         .iter()
         .fold(1.0f64, |m, v| m.max(v.abs()));
-    let eps = 1e-12 * scale * scale;
+    let lengths = (b.0 - a.0).hypot(b.1 - a.1) + (c.0 - a.0).hypot(c.1 - a.1);
+    let eps = 1e-12 * scale * lengths;
     if cross > eps {
         1
     } else if cross < -eps {
@@ -616,14 +620,18 @@ mod tests {
             state ^= state << 17;
             (state % 4) as i64
         };
-        for _ in 0..200_000 {
-            let p: Vec<(i64, i64)> = (0..4).map(|_| (next(), next())).collect();
-            let f = |q: (i64, i64)| (q.0 as f64, q.1 as f64);
-            assert_eq!(
-                segments_intersect(f(p[0]), f(p[1]), f(p[2]), f(p[3])),
-                intersect_oracle(p[0], p[1], p[2], p[3]),
-                "{p:?}"
-            );
+        // The grid as drawn, and shrunk to micrometres at x = 3 m (the tolerance must scale
+        // with the segments, not with the coordinates alone).
+        for (unit, at) in [(1.0, (0.0, 0.0)), (1e-6, (3.0, 1.0))] {
+            for _ in 0..200_000 {
+                let p: Vec<(i64, i64)> = (0..4).map(|_| (next(), next())).collect();
+                let f = |q: (i64, i64)| (at.0 + q.0 as f64 * unit, at.1 + q.1 as f64 * unit);
+                assert_eq!(
+                    segments_intersect(f(p[0]), f(p[1]), f(p[2]), f(p[3])),
+                    intersect_oracle(p[0], p[1], p[2], p[3]),
+                    "{p:?} at unit {unit}"
+                );
+            }
         }
     }
 
