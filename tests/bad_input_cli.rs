@@ -244,6 +244,48 @@ fn a_mapping_that_fails_midway_leaves_no_summary_or_report_of_other_maps() {
 }
 
 #[test]
+fn a_replacement_that_fails_halfway_leaves_the_old_run_marked_for_the_next() {
+    // Found in review (thirty-seventh session): had `meta.json` gone first, a removal that
+    // failed later would leave the old trajectories unmarked, and the next run (recording
+    // none) would keep them beside its own log.
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("r");
+    swarmmap()
+        .args([
+            "run",
+            TINY,
+            "--quiet",
+            "--seed",
+            "1",
+            "--trajectories",
+            "1",
+            "--out",
+        ])
+        .arg(&run)
+        .assert()
+        .success();
+    fs::remove_dir_all(run.join("maps")).unwrap();
+    fs::write(run.join("maps"), "in the way").unwrap();
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--seed", "2", "--out"])
+        .arg(&run)
+        .assert()
+        .code(1);
+    // Still marked as the old run, whose log and trajectories are intact.
+    assert!(run.join("meta.json").exists() && run.join("trajectories.csv").exists());
+    fs::remove_file(run.join("maps")).unwrap();
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--seed", "2", "--out"])
+        .arg(&run)
+        .assert()
+        .success();
+    assert!(!run.join("trajectories.csv").exists(), "{:?}", names(&run));
+    let meta: serde_json::Value =
+        serde_json::from_slice(&fs::read(run.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["seed"], 2);
+}
+
+#[test]
 fn an_output_path_that_is_a_file_is_named_once_with_the_fix() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("afile");
@@ -252,7 +294,7 @@ fn an_output_path_that_is_a_file_is_named_once_with_the_fix() {
         .args(["simulate", TINY, "--quiet", "--out"])
         .arg(&file)
         .assert()
-        .code(1)
+        .code(2)
         .stderr(
             contains("it is a file, not a directory; give --out a new or existing directory")
                 .and(contains("File exists").not()),
@@ -283,7 +325,7 @@ fn an_output_directory_that_cannot_be_written_is_refused_before_simulating() {
                 .arg(out)
                 .timeout(std::time::Duration::from_secs(20))
                 .assert()
-                .code(1)
+                .code(2)
                 .stderr(contains(out.display().to_string()));
         }
     }
@@ -338,10 +380,12 @@ fn a_campaign_refuses_the_same_run_listed_twice() {
     assert!(!out.exists(), "refused before any run");
     swarmmap()
         .args(["calibrate", TINY, TINY, "--seeds", "1..1", "--out"])
-        .arg(tmp.path().join("m.json"))
+        .arg(tmp.path().join("new").join("m.json"))
         .assert()
         .code(2)
         .stderr(contains("is given twice"));
+    // The output's directory is only checked, not made, before the refusal.
+    assert!(!tmp.path().join("new").exists());
 }
 
 #[test]

@@ -43,6 +43,9 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("runs/{}-seed{seed}", file_safe(&world.name))));
+    // Before the simulation, which may take hours: an output it cannot write is the
+    // user's to fix, and said now (`run_world` checks too, for library callers).
+    swarmmap::sim::prepare_out_dir(&out).map_err(input)?;
     let bar = progress_bar(args.quiet, "simulating");
     let report = |f: f64| {
         if let Some(b) = &bar {

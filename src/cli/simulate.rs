@@ -33,9 +33,9 @@ pub struct SimulateArgs {
 pub fn run(args: &SimulateArgs) -> Result<(), Failure> {
     let world = load_world(&args.world, &args.set)?;
     let seed = args.seed.unwrap_or(world.seed);
-    // Before the simulation, which may take hours: an output it cannot write is said now.
-    prepare_out_dir(&args.out)
-        .with_context(|| format!("writing the run into {}", args.out.display()))?;
+    // Before the simulation, which may take hours: an output it cannot write is the
+    // user's to fix, and said now.
+    prepare_out_dir(&args.out).map_err(input)?;
     let bar = progress_bar(args.quiet, "simulating");
     let report = |f: f64| {
         if let Some(b) = &bar {

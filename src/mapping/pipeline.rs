@@ -57,8 +57,10 @@ pub fn true_position(t: &[f64; 4]) -> [f64; 2] {
 
 /// Geometric fidelity of a local map against the log's truth columns (none without them).
 pub fn fidelity(map: &LocalMap, log: &EncounterLog, diagonal: f64, rips_points: usize) -> Fidelity {
-    // A window without events has all of its (no) truth; the log must have truth at all.
-    if !log.has_truth() {
+    // A window without events has all of its (no) truth, so ask the log: a log without
+    // truth columns gives no fidelity, not even for an empty window; an empty simulated
+    // log (no encounter lacks truth) still gives the empty window's oracle, (0, 0).
+    if log.encounters.iter().any(|e| e.truth.is_none()) {
         return Fidelity::default();
     }
     let Some(truth) = true_positions(map, log) else {

@@ -225,15 +225,17 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
     write_atomic(&path, bytes).map_err(|source| SimError::Write { path, source })
 }
 
-/// Removes an earlier run in `dir` before a new log replaces it: its `meta.json` first (a
-/// complete `meta.json` means a complete run, so from then on the directory no longer
-/// claims to hold one), then what was derived from its log (`summary.json`, the maps in
-/// `maps/`: each window's and connection's file, `connections.json`, `global.json`; the
-/// report in `report/`), then the log itself (`encounters.csv`, `static_intervals.csv`,
-/// `leader.csv`, `trajectories.csv`). Left in place, an interrupted write would leave a
-/// mix: the new encounters beside the old metadata, trajectories or report, read as one
-/// run. Only when `dir` holds a swarmmap run (its `meta.json` says so: these names are
-/// common enough that a user's own directory may hold them), and only those files of
+/// Removes an earlier run in `dir` before a new log replaces it: first what was derived
+/// from its log (`summary.json`, the report in `report/`, the maps in `maps/`: each
+/// window's and connection's file, `connections.json`, `global.json`) and its
+/// `trajectories.csv`, then its `meta.json` (a complete `meta.json` means a complete run),
+/// then the rest of its log (`encounters.csv`, `static_intervals.csv`, `leader.csv`). Left
+/// in place, an interrupted write would leave a mix: the new encounters beside the old
+/// metadata, trajectories or report, read as one run. In this order a removal that fails
+/// or is interrupted leaves either a directory still marked as the old run (the next run
+/// into it removes the rest) or only the three log files every run writes anew. Only
+/// when `dir` holds a swarmmap run (its `meta.json` says so: these names are common
+/// enough that a user's own directory may hold them), and only those files of
 /// swarmmap's; anything else in `dir` stays.
 fn remove_derived(dir: &Path) -> std::io::Result<()> {
     use crate::io::{is_numbered_map, remove_stale};
@@ -250,40 +252,45 @@ fn remove_derived(dir: &Path) -> std::io::Result<()> {
         return Ok(());
     }
     let none = std::collections::BTreeSet::new();
-    remove_stale(dir, &none, |n| n == "meta.json")?;
     remove_stale(dir, &none, |n| n == "summary.json")?;
     crate::report::remove_report(dir)?;
     remove_stale(&dir.join("maps"), &none, |n| {
         matches!(n, "connections.json" | "global.json") || is_numbered_map(n)
     })?;
+    remove_stale(dir, &none, |n| n == "trajectories.csv")?;
+    remove_stale(dir, &none, |n| n == "meta.json")?;
     remove_stale(dir, &none, |n| {
-        matches!(
-            n,
-            "encounters.csv" | "static_intervals.csv" | "leader.csv" | "trajectories.csv"
-        )
+        matches!(n, "encounters.csv" | "static_intervals.csv" | "leader.csv")
     })
 }
 
-/// Makes sure the run's files can be written into `dir` before a simulation that may take
-/// hours produces them: `dir` must be a directory (created if missing) in which a file can
-/// be created (one is, and removed at once). Nothing already in `dir` is touched.
+/// Whether files can be written into `dir`, asked before a simulation (or a fit) that may
+/// take hours produces them: `dir`, or else the nearest of its ancestors that exists (where
+/// it would be created), must be a directory in which a file can be made. The test file is
+/// unnamed (`tempfile::tempfile_in`: nothing to leave behind if interrupted), and nothing
+/// is created or touched: a command refused later for another reason leaves no directory.
 pub fn prepare_out_dir(dir: &Path) -> Result<(), SimError> {
     let fail = |source| SimError::Write {
         path: dir.to_path_buf(),
         source,
     };
-    if dir.exists() && !dir.is_dir() {
-        return Err(fail(std::io::Error::other(
-            "it is a file, not a directory; give --out a new or existing directory",
-        )));
+    let existing = dir
+        .ancestors()
+        .find(|a| a.exists())
+        .filter(|a| !a.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !existing.is_dir() {
+        let what = if existing == dir {
+            "it is a file, not a directory; give --out a new or existing directory".to_string()
+        } else {
+            format!(
+                "{} is a file, not a directory; give --out a path inside a directory",
+                existing.display()
+            )
+        };
+        return Err(fail(std::io::Error::other(what)));
     }
-    std::fs::create_dir_all(dir).map_err(fail)?;
-    tempfile::Builder::new()
-        .prefix(".swarmmap-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map(drop)
-        .map_err(fail)
+    tempfile::tempfile_in(existing).map(drop).map_err(fail)
 }
 
 /// Writes the run's files into `dir` (created if missing), each atomically:
@@ -291,6 +298,10 @@ pub fn prepare_out_dir(dir: &Path) -> Result<(), SimError> {
 /// `trajectories.csv` when trajectories were recorded.
 pub fn write_run(dir: &Path, world: &World, out: &SimOutput) -> Result<(), SimError> {
     prepare_out_dir(dir)?;
+    std::fs::create_dir_all(dir).map_err(|source| SimError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     remove_derived(dir).map_err(|source| SimError::Write {
         path: dir.to_path_buf(),
         source,
