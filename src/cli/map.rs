@@ -208,16 +208,15 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
     })?;
     // A report made from the previous maps would be stale: it goes before they are
-    // replaced (an interrupted or failed write then leaves no report of other maps) and is
-    // made again from the new ones.
+    // replaced (an interrupted or failed write then leaves no report of other maps, nor
+    // the figures of a report interrupted earlier) and, if there was one, is made again
+    // from the new ones.
     let page = args.run_dir.join("report").join("index.html");
     let had_report = page.exists();
-    if had_report {
-        swarmmap::report::remove_report(&args.run_dir).map_err(|source| PipelineError::Write {
-            path: args.run_dir.join("report"),
-            source,
-        })?;
-    }
+    swarmmap::report::remove_report(&args.run_dir).map_err(|source| PipelineError::Write {
+        path: args.run_dir.join("report"),
+        source,
+    })?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
     if had_report {
