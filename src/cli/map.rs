@@ -219,6 +219,18 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     })?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
+    if !log.encounters.is_empty() && mapped.summary.global.betti[0] == 0 {
+        // Every component of every window was judged noise: the maps are empty although
+        // the log is not (a log too sparse for its windows, or windows too short).
+        eprintln!(
+            "warning: every window's encounters were judged noise (β0 = 0 everywhere) although \
+             {} holds {} encounter(s): the log is too sparse for {} window(s); map it with \
+             fewer --windows, or record more encounters",
+            encounters_csv.display(),
+            log.encounters.len(),
+            cfg.windows
+        );
+    }
     if had_report {
         swarmmap::report::write_report(&args.run_dir).map_err(super::report::failure)?;
         println!("report refreshed: {}", page.display());
