@@ -457,6 +457,69 @@ fn smaller_findings_of_an_adversarial_pass() {
 }
 
 #[test]
+fn stored_runs_of_another_build_are_made_again() {
+    // The adversarial pass of the thirty-seventh session: `eval` and `calibrate --runs`
+    // reused runs whatever build had made them, so an upgrade judged old maps as new.
+    // Another build here: a copy of the binary with one byte appended (still runnable).
+    let tmp = tempfile::tempdir().unwrap();
+    let other = tmp.path().join("swarmmap-other");
+    let mut bytes = fs::read(assert_cmd::cargo::cargo_bin("swarmmap")).unwrap();
+    bytes.push(0);
+    fs::write(&other, bytes).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        fs::set_permissions(&other, fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let build_of = |dir: &Path| -> String {
+        let runs = dir.join("runs");
+        let file = runs.join(&names(&runs)[0]);
+        let v: serde_json::Value = serde_json::from_slice(&fs::read(file).unwrap()).unwrap();
+        v["build"].as_str().unwrap().to_string()
+    };
+    let ev = tmp.path().join("ev");
+    let eval = |cmd: &mut Command, extra: &[&str]| {
+        cmd.args(["eval", TINY, "--seeds", "1", "--quiet", "--out"])
+            .arg(&ev)
+            .args(extra)
+            .assert()
+            .success();
+    };
+    eval(&mut swarmmap(), &[]);
+    let first = build_of(&ev);
+    eval(&mut Command::new(&other), &[]);
+    let second = build_of(&ev);
+    assert_ne!(
+        first, second,
+        "the other build ran it again and recorded itself"
+    );
+    assert_eq!(
+        names(&ev.join("runs")).len(),
+        1,
+        "the run's file was replaced"
+    );
+    // Asked to, a build reuses what another made.
+    eval(&mut swarmmap(), &["--reuse-any-build"]);
+    assert_eq!(build_of(&ev), second);
+
+    let runs = tmp.path().join("cal");
+    let calibrate = |cmd: &mut Command, extra: &[&str], says: &str| {
+        cmd.args(["calibrate", TINY, "--seeds", "1..1", "--out"])
+            .arg(tmp.path().join("m.json"))
+            .arg("--runs")
+            .arg(&runs)
+            .args(extra)
+            .assert()
+            .success()
+            .stderr(contains(says));
+    };
+    calibrate(&mut swarmmap(), &[], "seed 1 done");
+    calibrate(&mut swarmmap(), &[], "seed 1 reused");
+    calibrate(&mut Command::new(&other), &[], "seed 1 done");
+    calibrate(&mut swarmmap(), &["--reuse-any-build"], "seed 1 reused");
+}
+
+#[test]
 fn a_world_name_cannot_lead_the_default_output_outside_runs() {
     let tmp = tempfile::tempdir().unwrap();
     let world = std::env::current_dir().unwrap().join(TINY);

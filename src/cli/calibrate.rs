@@ -79,10 +79,14 @@ pub struct CalibrateArgs {
     pub landscape: Option<PathBuf>,
     /// Keep each finished training run's diagrams in DIR (one JSON file per world, `--set`
     /// values and seed) and reuse them on a later call, so an interrupted or extended fit
-    /// (more seeds, another cap, cross-validation) does not simulate them again. Delete DIR
-    /// after changing swarmmap's mapping code: the files hold its output.
+    /// (more seeds, another cap, cross-validation) does not simulate them again. Only the
+    /// runs this build of swarmmap stored are reused (another build runs them again),
+    /// unless `--reuse-any-build`.
     #[arg(long, value_name = "DIR")]
     pub runs: Option<PathBuf>,
+    /// With `--runs`, reuse the runs stored there whatever build of swarmmap made them.
+    #[arg(long, requires = "runs")]
+    pub reuse_any_build: bool,
 }
 
 /// One training run as `--runs` keeps it: per fit it fed, its windows' features, truths
@@ -94,6 +98,11 @@ struct StoredRun {
     world: String,
     seed: u64,
     fits: Vec<StoredFit>,
+    /// The build of swarmmap that made the run (`eval::campaign::build_id`); absent in
+    /// runs stored before builds were recorded. Another build's run is made again unless
+    /// `--reuse-any-build`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    build: Option<String>,
 }
 
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -328,6 +337,17 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             jobs.push((world, seed, stored));
         }
     }
+    // This build, whose stored runs alone are reused (none: any build's, with
+    // `--reuse-any-build`).
+    let build = if args.reuse_any_build {
+        None
+    } else {
+        Some(
+            swarmmap::eval::campaign::build_id()
+                .context("reading swarmmap's own executable to tell its build")
+                .map_err(Failure::Other)?,
+        )
+    };
     let threads = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -343,6 +363,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 if let Some(file) = stored
                     && let Ok(text) = std::fs::read_to_string(file)
                     && let Ok(run) = serde_json::from_str::<StoredRun>(&text)
+                    && (build.is_none() || run.build.as_deref() == build)
                 {
                     eprintln!(
                         "calibrate: {} seed {seed} reused from {}",
@@ -419,6 +440,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                                 windows: samples.iter().map(StoredWindow::from_sample).collect(),
                             })
                             .collect(),
+                        build: build.map(String::from),
                     };
                     let mut bytes = serde_json::to_vec(&run).map_err(|e| e.to_string())?;
                     bytes.push(b'\n');

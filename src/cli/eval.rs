@@ -33,6 +33,10 @@ pub struct EvalArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Reuse the runs stored in DIR whatever build of swarmmap made them (by default a
+    /// run stored by another build, an upgrade or a change to the code, is run again).
+    #[arg(long)]
+    pub reuse_any_build: bool,
 }
 
 /// Parses `A..B` (inclusive) or `a,b,c`. A seed listed twice is refused: each seed is one
@@ -140,7 +144,15 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
             b.inc(1);
         }
     };
-    let records = run_campaign(&jobs, &args.out, threads.max(1), &tick)
+    let build = if args.reuse_any_build {
+        None
+    } else {
+        Some(
+            swarmmap::eval::campaign::build_id()
+                .context("reading swarmmap's own executable to tell its build")?,
+        )
+    };
+    let records = run_campaign(&jobs, &args.out, threads.max(1), build, &tick)
         .with_context(|| format!("running the campaign in {}", args.out.display()))?;
     if let Some(b) = &bar {
         b.finish_and_clear();

@@ -41,7 +41,8 @@ impl Job {
     /// A file-name key that changes with the world's text, the overrides, the seed and
     /// `models`: the classifier models the run is judged with, when they are not the
     /// shipped ones (`--model FILE`; [`models_part`]). Runs judged with the shipped models
-    /// keep the keys they had before models were part of it.
+    /// keep the keys they had before models were part of it. (The build that made a run is
+    /// recorded in it, [`RunRecord::build`], not in its key: a new build replaces the file.)
     pub fn key(&self, world_text: &str, models: Option<&[u8]>) -> String {
         let params = self.params();
         let mut parts = vec![world_text.as_bytes(), params.as_bytes()];
@@ -61,6 +62,30 @@ pub fn models_part() -> Option<Vec<u8>> {
     // cannot fail.
     (active != Models::shipped())
         .then(|| serde_json::to_vec(&active).expect("classifier models serialize to JSON"))
+}
+
+/// The identity of this build of swarmmap: the SHA-256 of the running executable, in hex,
+/// read once. Stored runs (`eval`'s `DIR/runs/`, `calibrate --runs`) record it, since they
+/// hold what this build's simulation and mapping made: another build (an upgrade, a change
+/// to the code) runs them again instead of reusing what it would not have made, unless the
+/// user asks to reuse runs of any build.
+pub fn build_id() -> std::io::Result<&'static str> {
+    static ID: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    if let Some(id) = ID.get() {
+        return Ok(id);
+    }
+    use std::io::Read;
+    let mut file = std::fs::File::open(std::env::current_exe()?)?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 20];
+    loop {
+        match file.read(&mut buf)? {
+            0 => break,
+            n => h.update(&buf[..n]),
+        }
+    }
+    let hex: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    Ok(ID.get_or_init(|| hex))
 }
 
 /// A stored run's file-name key, `<world stem>-<12 hex digits>-s<seed>`: the hex digits are
@@ -109,6 +134,10 @@ pub struct RunRecord {
     /// The run's summary (absent if it failed).
     pub summary: Option<serde_json::Value>,
     pub error: Option<String>,
+    /// The build of swarmmap that made the run ([`build_id`]); absent in runs stored before
+    /// builds were recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build: Option<String>,
 }
 
 fn run_one(job: &Job, text: &str) -> RunRecord {
@@ -144,6 +173,7 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
             seed: job.seed,
             summary: serde_json::to_value(&s).ok(),
             error: None,
+            build: None,
         },
         Err(e) => RunRecord {
             world,
@@ -152,16 +182,20 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
             seed: job.seed,
             summary: None,
             error: Some(e),
+            build: None,
         },
     }
 }
 
 /// Runs every job not yet recorded in `dir/runs/`, `jobs` at a time, calling `tick`
-/// after each; returns all records (old and new) sorted by world, params, seed.
+/// after each; returns all records (old and new) sorted by world, params, seed. With
+/// `build` (this build, [`build_id`]), a run recorded by another build, or by none, counts
+/// as not recorded and is run again; with `None`, any recorded run is reused.
 pub fn run_campaign(
     jobs: &[Job],
     dir: &Path,
     threads: usize,
+    build: Option<&str>,
     tick: &(dyn Fn(&RunRecord) + Sync),
 ) -> std::io::Result<Vec<RunRecord>> {
     let runs = dir.join("runs");
@@ -184,11 +218,13 @@ pub fn run_campaign(
                 let path = runs.join(format!("{}.json", job.key(text, models.as_deref())));
                 if let Ok(old) = std::fs::read_to_string(&path)
                     && let Ok(rec) = serde_json::from_str::<RunRecord>(&old)
+                    && (build.is_none() || rec.build.as_deref() == build)
                 {
                     tick(&rec);
                     return Ok(rec);
                 }
-                let rec = run_one(job, text);
+                let mut rec = run_one(job, text);
+                rec.build = build.map(String::from);
                 let mut bytes = serde_json::to_vec_pretty(&rec).map_err(std::io::Error::other)?;
                 bytes.push(b'\n');
                 write_atomic(&path, &bytes)?;
@@ -745,6 +781,13 @@ mod tests {
         let m2 = job.key("(name: \"w\")", Some(b"{\"m\":2}"));
         assert!(m1 != plain && m1 != m2, "{plain} {m1} {m2}");
         assert_eq!(models_part(), None, "tests map with the shipped models");
+        // This build's identity: the test binary's SHA-256, the same each time it is asked.
+        let id = build_id().unwrap();
+        assert!(
+            id.len() == 64 && id.bytes().all(|b| b.is_ascii_hexdigit()),
+            "{id}"
+        );
+        assert_eq!(build_id().unwrap(), id);
     }
 
     #[test]
@@ -776,6 +819,7 @@ mod tests {
                 "timings": {"a": 2.0}
             })),
             error: None,
+            build: None,
         }
     }
 
