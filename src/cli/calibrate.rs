@@ -1,7 +1,7 @@
 //! `swarmmap calibrate [WORLD...] [--seeds 1..5] [--set PATH=VALUE]... [--out FILE]`: fit the
 //! robust-feature classifier on training worlds and write the model file.
 
-use super::{Failure, input, load_world, refuse_repeated_worlds};
+use super::{Failure, input, load_world, refuse_repeated_worlds, reusable_build};
 use anyhow::{Context, anyhow};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
@@ -339,15 +339,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     }
     // This build, whose stored runs alone are reused (none: any build's, with
     // `--reuse-any-build`).
-    let build = if args.reuse_any_build {
-        None
-    } else {
-        Some(
-            swarmmap::eval::campaign::build_id()
-                .context("reading swarmmap's own executable to tell its build")
-                .map_err(Failure::Other)?,
-        )
-    };
+    let build = reusable_build(args.reuse_any_build)?;
     let threads = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

@@ -73,12 +73,8 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
 pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     let seeds = parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
     super::refuse_repeated_worlds(&args.worlds)?;
-    if args.out.exists() && !args.out.is_dir() {
-        return Err(input(anyhow!(
-            "--out {} is a file, not a directory; give the campaign a new or existing directory",
-            args.out.display()
-        )));
-    }
+    // Before any run: a campaign directory that cannot be written is the user's to fix.
+    swarmmap::sim::prepare_out_dir(&args.out).map_err(input)?;
     let mut sweeps: Vec<(String, Vec<String>)> = Vec::new();
     for s in &args.set {
         let (path, values) = s.split_once('=').ok_or_else(|| {
@@ -144,14 +140,7 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
             b.inc(1);
         }
     };
-    let build = if args.reuse_any_build {
-        None
-    } else {
-        Some(
-            swarmmap::eval::campaign::build_id()
-                .context("reading swarmmap's own executable to tell its build")?,
-        )
-    };
+    let build = super::reusable_build(args.reuse_any_build)?;
     let records = run_campaign(&jobs, &args.out, threads.max(1), build, &tick)
         .with_context(|| format!("running the campaign in {}", args.out.display()))?;
     if let Some(b) = &bar {

@@ -54,6 +54,19 @@ pub fn refuse_repeated_worlds(worlds: &[std::path::PathBuf]) -> Result<(), Failu
     Ok(())
 }
 
+/// The build whose stored runs a campaign or a fit may reuse: this one
+/// (`campaign::build_id`), or, with `--reuse-any-build`, none in particular.
+pub fn reusable_build(reuse_any_build: bool) -> Result<Option<&'static str>, Failure> {
+    if reuse_any_build {
+        return Ok(None);
+    }
+    swarmmap::eval::campaign::build_id().map(Some).map_err(|e| {
+        Failure::Other(
+            anyhow::Error::new(e).context("reading swarmmap's own executable to tell its build"),
+        )
+    })
+}
+
 /// Loads a world file and applies `--set PATH=VALUE` overrides; any problem is an input
 /// error (status 2).
 pub fn load_world(
