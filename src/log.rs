@@ -234,6 +234,7 @@ impl CsvFile {
                     let row = Row {
                         record: &record,
                         columns: &self.columns,
+                        line,
                     };
                     f(&row).map_err(|message| LogError::Csv {
                         path: self.path.clone(),
@@ -277,6 +278,8 @@ pub const MAX_POSITION: f64 = 1e9;
 struct Row<'a> {
     record: &'a csv::StringRecord,
     columns: &'a Columns,
+    /// The record's 1-based line in its file.
+    line: u64,
 }
 
 /// A cell as an error message shows it: control characters (a NUL byte, a tab) and the
@@ -518,14 +521,34 @@ fn read_static(path: &Path) -> Result<Vec<StaticInterval>, LogError> {
     Ok(out)
 }
 
+/// The leader's track, sorted by time. Rows may come in any order, and a row may repeat
+/// another; two rows that put the leader at two places at one time are an error, since the
+/// track could not say which to draw.
 fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
     let mut f = CsvFile::open(path, &["time", "x"])?;
-    let mut out = Vec::new();
+    let mut rows = Vec::new();
     f.for_each(|row| {
-        out.push((row.time("time")?, row.position("x")?));
+        rows.push((row.time("time")?, row.position("x")?, row.line));
         Ok(())
     })?;
-    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Stable: rows of one time keep their file order, so the earlier line comes first.
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some(w) = rows
+        .windows(2)
+        .find(|w| w[0].0 == w[1].0 && w[0].1 != w[1].1)
+    {
+        let ((time, x0, first), (_, x1, second)) = (w[0], w[1]);
+        return Err(LogError::Csv {
+            path: path.to_path_buf(),
+            line: second,
+            message: format!(
+                "this row puts the leader at x = {x1} m at time {time} s, but line {first} \
+                 puts it at x = {x0} m then; keep one row per time (correct or remove one)"
+            ),
+        });
+    }
+    let mut out: Vec<(f64, f64)> = rows.into_iter().map(|(t, x, _)| (t, x)).collect();
+    out.dedup();
     Ok(out)
 }
 
@@ -634,5 +657,32 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
         assert!(e.contains("file not found"), "{e}");
+    }
+
+    fn leader_of(text: &str) -> Result<Vec<(f64, f64)>, String> {
+        let d = dir_with(&[
+            ("encounters.csv", "start,end,a,b\n0,1,0,1\n"),
+            ("leader.csv", text),
+        ]);
+        EncounterLog::read_dir(d.path())
+            .map(|log| log.leader)
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn the_leader_track_is_sorted_and_its_repeated_rows_read_once() {
+        let track = leader_of("time,x\n10,2.0\n0,1.5\n5,1.75\n10,2.0\n").unwrap();
+        assert_eq!(track, vec![(0.0, 1.5), (5.0, 1.75), (10.0, 2.0)]);
+    }
+
+    #[test]
+    fn two_places_of_the_leader_at_one_time_name_both_lines() {
+        // Line 2 and line 4 disagree about t = 10 s; line 3 lies between them in time order.
+        let e = leader_of("time,x\n10,2.0\n0,1.5\n10,2.5\n").unwrap_err();
+        assert!(
+            e.contains("leader.csv:4: this row puts the leader at x = 2.5 m at time 10 s, but line 2 puts it at x = 2 m")
+                && e.contains("keep one row per time"),
+            "{e}"
+        );
     }
 }

@@ -389,6 +389,43 @@ fn a_campaign_refuses_the_same_run_listed_twice() {
 }
 
 #[test]
+fn a_field_set_twice_is_refused_by_every_command() {
+    // Before, `run`, `simulate`, `check` and `calibrate` let the last `--set` of a field win
+    // unseen, so `--set swarm.agents=3 --set swarm.agents=4` ran 4 agents without a word.
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let twice = ["--set", "swarm.agents=3", "--set", " swarm.agents = 4"];
+    for command in [
+        &["check"][..],
+        &["simulate", "--quiet"],
+        &["run", "--no-report"],
+    ] {
+        let mut cmd = swarmmap();
+        cmd.args(command).arg(TINY).args(twice);
+        if command[0] != "check" {
+            cmd.arg("--out").arg(&out);
+        }
+        cmd.assert().code(2).stderr(contains(
+            "--set swarm.agents is given twice (`swarm.agents=3`, then ` swarm.agents = 4`); give each field once",
+        ));
+    }
+    swarmmap()
+        .args(["calibrate", TINY, "--seeds", "1..1"])
+        .args(twice)
+        .arg("--out")
+        .arg(tmp.path().join("m.json"))
+        .assert()
+        .code(2)
+        .stderr(contains("--set swarm.agents is given twice"));
+    assert!(!out.exists() && !tmp.path().join("m.json").exists());
+    // Two different fields are fine.
+    swarmmap()
+        .args(["check", TINY, "--set", "swarm.agents=3", "--set", "seed=2"])
+        .assert()
+        .success();
+}
+
+#[test]
 fn smaller_findings_of_an_adversarial_pass() {
     let tmp = tempfile::tempdir().unwrap();
     let log = |name: &str, text: &str| {

@@ -3,7 +3,7 @@
 use super::{Failure, input};
 use clap::Args;
 use std::path::PathBuf;
-use swarmmap::world::{WorldSpec, apply_assignment};
+use swarmmap::world::WorldSpec;
 
 /// Validate a world file and print a short summary (exit status 2 if it is invalid).
 #[derive(Debug, Args)]
@@ -19,9 +19,7 @@ pub struct CheckArgs {
 pub fn run(args: &CheckArgs) -> Result<(), Failure> {
     // A missing or unreadable world file is the user's input too: status 2.
     let mut spec = WorldSpec::load(&args.world).map_err(input)?;
-    for assignment in &args.set {
-        apply_assignment(&mut spec, assignment).map_err(input)?;
-    }
+    super::apply_sets(&mut spec, &args.set)?;
     let world = spec.check().map_err(input)?;
     println!("{}", world.summary());
     Ok(())

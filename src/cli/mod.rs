@@ -74,10 +74,26 @@ pub fn load_world(
     sets: &[String],
 ) -> Result<swarmmap::world::World, Failure> {
     let mut spec = swarmmap::world::WorldSpec::load(path).map_err(input)?;
-    for assignment in sets {
-        swarmmap::world::apply_assignment(&mut spec, assignment).map_err(input)?;
-    }
+    apply_sets(&mut spec, sets)?;
     spec.check().map_err(input)
+}
+
+/// Applies `--set PATH=VALUE` overrides in order, refusing a field set twice: one of the two
+/// values would be dropped unseen (a sweep of values is `eval`'s `--set PATH=V1,V2`).
+pub fn apply_sets(spec: &mut swarmmap::world::WorldSpec, sets: &[String]) -> Result<(), Failure> {
+    let mut seen = std::collections::BTreeMap::new();
+    for assignment in sets {
+        if let Some((path, _)) = assignment.split_once('=')
+            && let Some(first) = seen.insert(path.trim().to_string(), assignment)
+        {
+            return Err(input(anyhow::anyhow!(
+                "--set {} is given twice (`{first}`, then `{assignment}`); give each field once",
+                path.trim()
+            )));
+        }
+        swarmmap::world::apply_assignment(spec, assignment).map_err(input)?;
+    }
+    Ok(())
 }
 
 /// Most worker threads a command takes (`--jobs`, `--threads`): far beyond any machine's
