@@ -231,6 +231,7 @@ impl FreeSpace {
                 rows: (j0, j1),
                 ny,
                 cell: (h, h),
+                origin: (0.0, 0.0),
             };
             // A NaN distance blocks the cell: never free by accident.
             clear_obstacle_cells(obstacle, margin, block, &mut free);

@@ -46,9 +46,11 @@ pub fn point_in_polygon(p: Vec2, poly: &[Vec2]) -> bool {
 
 /// A block of raster cells: columns `cols.0..=cols.1` and rows `rows.0..=rows.1` of a
 /// column-major raster with `ny` rows, cell `(i, j)` centred at
-/// `((i + 0.5) · cell.0, (j + 0.5) · cell.1)`.
+/// `(origin.0 + (i + 0.5) · cell.0, origin.1 + (j + 0.5) · cell.1)`.
 #[derive(Debug, Clone, Copy)]
 pub struct CellBlock {
+    /// Lower-left corner of the raster's cell `(0, 0)`, metres.
+    pub origin: Vec2,
     /// First and last column.
     pub cols: (usize, usize),
     /// First and last row.
@@ -61,13 +63,13 @@ pub struct CellBlock {
 
 impl CellBlock {
     /// Centre of column `i`, metres.
-    fn x(&self, i: usize) -> f64 {
-        (i as f64 + 0.5) * self.cell.0
+    pub(crate) fn x(&self, i: usize) -> f64 {
+        self.origin.0 + (i as f64 + 0.5) * self.cell.0
     }
 
     /// Centre of row `j`, metres.
-    fn y(&self, j: usize) -> f64 {
-        (j as f64 + 0.5) * self.cell.1
+    pub(crate) fn y(&self, j: usize) -> f64 {
+        self.origin.1 + (j as f64 + 0.5) * self.cell.1
     }
 }
 
@@ -116,6 +118,7 @@ fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mu
         rows: (j0, j1),
         ny,
         cell: (cx, cy),
+        origin,
     } = block;
     let n = points.len();
     if n == 0 || i0 > i1 || j0 > j1 {
@@ -156,9 +159,9 @@ fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mu
     }
     // Outside: within `margin` of some edge. A centre more than a cell outside an edge's
     // box grown by `margin` is farther than `margin` from the edge.
-    let range = |lo: f64, hi: f64, c: f64, first: usize, last: usize| {
-        let a = ((lo - margin) / c - 0.5).floor() - 1.0;
-        let b = ((hi + margin) / c - 0.5).ceil() + 1.0;
+    let range = |lo: f64, hi: f64, o: f64, c: f64, first: usize, last: usize| {
+        let a = ((lo - margin - o) / c - 0.5).floor() - 1.0;
+        let b = ((hi + margin - o) / c - 0.5).ceil() + 1.0;
         let a = a.max(first as f64);
         let b = b.min(last as f64);
         (a <= b).then_some((a as usize, b as usize))
@@ -166,8 +169,8 @@ fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mu
     for k in 0..n {
         let (a, b) = (points[k], points[(k + 1) % n]);
         let (Some((ia, ib)), Some((ja, jb))) = (
-            range(a.0.min(b.0), a.0.max(b.0), cx, i0, i1),
-            range(a.1.min(b.1), a.1.max(b.1), cy, j0, j1),
+            range(a.0.min(b.0), a.0.max(b.0), origin.0, cx, i0, i1),
+            range(a.1.min(b.1), a.1.max(b.1), origin.1, cy, j0, j1),
         ) else {
             continue;
         };
@@ -447,7 +450,10 @@ mod tests {
             for j in b.rows.0..=b.rows.1 {
                 let c = i * b.ny + j;
                 if free[c] {
-                    let p = ((i as f64 + 0.5) * b.cell.0, (j as f64 + 0.5) * b.cell.1);
+                    let p = (
+                        b.origin.0 + (i as f64 + 0.5) * b.cell.0,
+                        b.origin.1 + (j as f64 + 0.5) * b.cell.1,
+                    );
                     free[c] = o.signed_distance(p) > margin;
                 }
             }
@@ -482,11 +488,19 @@ mod tests {
                 }
             }
             let margin = [0.0, 0.004, 0.0171, 0.2, -0.05][(case / 5) % 5];
+            // Rasters anchored at the origin (the free-space rasters) and elsewhere (a
+            // disc's samples, `FreeSpaceRaster::disc_free_area`).
+            let origin = if case % 3 == 2 {
+                (rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0))
+            } else {
+                (0.0, 0.0)
+            };
             let block = CellBlock {
                 cols: (rng.random_range(0..20), nx - 1 - rng.random_range(0..20)),
                 rows: (rng.random_range(0..20), ny - 1 - rng.random_range(0..20)),
                 ny,
                 cell,
+                origin,
             };
             // Some cells already blocked stay blocked.
             let start: Vec<bool> = (0..nx * ny).map(|_| rng.random_range(0..10) > 0).collect();
