@@ -230,13 +230,21 @@ impl FreeSpaceRaster {
         };
         for o in &world.obstacles {
             let (lo, hi) = o.bounding_box();
-            let (Some(cols), Some(rows)) = (
-                samples(lo.0, hi.0, origin.0),
-                samples(lo.1, hi.1, origin.1),
-            ) else {
+            let (Some(cols), Some(rows)) =
+                (samples(lo.0, hi.0, origin.0), samples(lo.1, hi.1, origin.1))
+            else {
                 continue;
             };
-            clear_obstacle_cells(o, body, CellBlock { cols, rows, ..block }, &mut free);
+            clear_obstacle_cells(
+                o,
+                body,
+                CellBlock {
+                    cols,
+                    rows,
+                    ..block
+                },
+                &mut free,
+            );
         }
         free.iter().filter(|f| **f).count() as f64 * side * side
     }

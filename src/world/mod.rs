@@ -10,6 +10,7 @@
 //! and, when the field is in the text, its `file:line:col`.
 
 mod check;
+mod distance_index;
 mod error;
 mod freespace;
 mod geometry;
@@ -19,6 +20,7 @@ mod summary;
 mod types;
 
 pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, landmark_count, short};
+pub use distance_index::{MIN_INDEXED_VERTICES, ObstacleDistances};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;
 pub use geometry::{
