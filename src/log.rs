@@ -543,7 +543,8 @@ fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
             line: second,
             message: format!(
                 "this row puts the leader at x = {x1} m at time {time} s, but line {first} \
-                 puts it at x = {x0} m then; keep one row per time (correct or remove one)"
+                 puts it at x = {x0} m then; keep one row per time (correct or remove one; \
+                 leader.csv is optional, only the report draws it)"
             ),
         });
     }

@@ -406,7 +406,7 @@ fn a_field_set_twice_is_refused_by_every_command() {
             cmd.arg("--out").arg(&out);
         }
         cmd.assert().code(2).stderr(contains(
-            "--set swarm.agents is given twice (`swarm.agents=3`, then ` swarm.agents = 4`); give each field once",
+            "--set swarm.agents is given twice (`swarm.agents=3`, then ` swarm.agents = 4`), so one value would be lost",
         ));
     }
     swarmmap()
@@ -418,11 +418,48 @@ fn a_field_set_twice_is_refused_by_every_command() {
         .code(2)
         .stderr(contains("--set swarm.agents is given twice"));
     assert!(!out.exists() && !tmp.path().join("m.json").exists());
-    // Two different fields are fine.
-    swarmmap()
-        .args(["check", TINY, "--set", "swarm.agents=3", "--set", "seed=2"])
-        .assert()
-        .success();
+    // A section after one of its fields would drop the field; found in review.
+    let circle = "Circle(center: (1.0, 1.0), radius: 0.2)";
+    for (first, then, says) in [
+        (
+            "swarm.agents=3",
+            "swarm=(speed: 0.1)",
+            "--set swarm replaces the whole of what an earlier --set swarm.agents set",
+        ),
+        (
+            "obstacles.scale=2",
+            "obstacles=[]",
+            "--set obstacles replaces the whole of what an earlier --set obstacles.scale set",
+        ),
+        (
+            "obstacles[00]=C",
+            "obstacles[0]=C",
+            "--set obstacles[0] is given twice",
+        ),
+    ] {
+        swarmmap()
+            .args(["check", TINY, "--set"])
+            .arg(first.replace('C', circle))
+            .arg("--set")
+            .arg(then.replace('C', circle))
+            .assert()
+            .code(2)
+            .stderr(contains(says));
+    }
+    // Different fields, a section and then its fields, and scale factors (they compose)
+    // are fine.
+    for sets in [
+        &["swarm.agents=3", "seed=2"][..],
+        &["swarm=(speed: 0.1)", "swarm.agents=3"],
+        &["obstacles.scale=0.5", "obstacles.scale=0.5"],
+    ] {
+        let mut cmd = swarmmap();
+        cmd.args(["check", TINY]);
+        for s in sets {
+            cmd.args(["--set", s]);
+        }
+        cmd.assert().success();
+    }
 }
 
 #[test]

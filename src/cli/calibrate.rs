@@ -266,7 +266,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     if args.stability {
         match set
             .iter()
-            .find(|s| s.starts_with("mapping.split_stability"))
+            .find(|s| s.trim_start().starts_with("mapping.split_stability"))
         {
             Some(s) if s.split_once('=').map(|(_, v)| v.trim()) != Some("true") => {
                 return Err(input(anyhow!(

@@ -78,22 +78,57 @@ pub fn load_world(
     spec.check().map_err(input)
 }
 
-/// Applies `--set PATH=VALUE` overrides in order, refusing a field set twice: one of the two
-/// values would be dropped unseen (a sweep of values is `eval`'s `--set PATH=V1,V2`).
+/// Applies `--set PATH=VALUE` overrides in order, refusing one whose value a later one
+/// would drop unseen: the same field twice, or a field and then its whole section
+/// (`swarm.agents=3` then `swarm=(...)`, `obstacles[0]=...` or `obstacles.scale=2` then
+/// `obstacles=[...]`). A section and then one of its fields is a refinement, and repeated
+/// `obstacles.scale` factors compose; both are fine. (`eval` sweeps values as
+/// `--set PATH=V1,V2`.)
 pub fn apply_sets(spec: &mut swarmmap::world::WorldSpec, sets: &[String]) -> Result<(), Failure> {
-    let mut seen = std::collections::BTreeMap::new();
+    let mut earlier: Vec<(String, &String)> = Vec::new();
     for assignment in sets {
-        if let Some((path, _)) = assignment.split_once('=')
-            && let Some(first) = seen.insert(path.trim().to_string(), assignment)
-        {
-            return Err(input(anyhow::anyhow!(
-                "--set {} is given twice (`{first}`, then `{assignment}`); give each field once",
-                path.trim()
-            )));
+        if let Some((path, _)) = assignment.split_once('=') {
+            let key = setting_key(path);
+            let dropped = earlier.iter().find(|(k, _)| {
+                (*k == key && key != "obstacles.scale")
+                    || k.starts_with(&format!("{key}."))
+                    || k.starts_with(&format!("{key}["))
+            });
+            if let Some((k, first)) = dropped {
+                let what = if *k == key {
+                    format!("--set {key} is given twice")
+                } else {
+                    format!("--set {key} replaces the whole of what an earlier --set {k} set")
+                };
+                return Err(input(anyhow::anyhow!(
+                    "{what} (`{first}`, then `{assignment}`), so one value would be lost; \
+                     give each field once, and a section before its fields"
+                )));
+            }
+            earlier.push((key, assignment));
         }
         swarmmap::world::apply_assignment(spec, assignment).map_err(input)?;
     }
     Ok(())
+}
+
+/// A `--set` path as compared for repeats: trimmed, each part trimmed, indices as numbers
+/// (`obstacles[01]` is `obstacles[1]`).
+fn setting_key(path: &str) -> String {
+    path.trim()
+        .split('.')
+        .map(|part| {
+            let part = part.trim();
+            match part.strip_suffix(']').and_then(|p| p.split_once('[')) {
+                Some((name, index)) => match index.trim().parse::<usize>() {
+                    Ok(i) => format!("{}[{i}]", name.trim()),
+                    Err(_) => part.to_string(),
+                },
+                None => part.to_string(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(".")
 }
 
 /// Most worker threads a command takes (`--jobs`, `--threads`): far beyond any machine's

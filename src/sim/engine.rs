@@ -249,8 +249,8 @@ impl Agent {
     /// tangent nearer the agent's heading, for a length drawn with mean
     /// `swarm.wall_following_length`. No random number is drawn when the probability is
     /// 0, so the paper's random walk keeps its exact sequence of draws.
-    fn wall_contact(&mut self, walls: &Walls<'_>, p: P) -> bool {
-        let prob = walls.world.swarm.wall_following;
+    fn wall_contact(&mut self, terrain: &Terrain<'_>, p: P) -> bool {
+        let prob = terrain.world.swarm.wall_following;
         if prob <= 0.0 || self.state != AgentState::Walk {
             return false;
         }
@@ -263,7 +263,7 @@ impl Agent {
             // followed (still touched, so no new contact reports it), or the agent would
             // press into the wall until its next run.
             if let Some(f) = self.follow.take()
-                && let Some((_, n)) = wall_geometry(walls, f.wall, p)
+                && let Some((_, n)) = wall_geometry(terrain, f.wall, p)
             {
                 self.normals.push((n, f.wall));
             }
@@ -272,7 +272,7 @@ impl Agent {
         if let Some(f) = &mut self.follow {
             // A different wall ahead (a concave corner) is followed on; one beside or
             // behind (a graze in a narrow passage) is not, or the follower would reverse.
-            let ahead = wall_geometry(walls, f.wall, p).map(|(_, n)| tangent(n, f.sense));
+            let ahead = wall_geometry(terrain, f.wall, p).map(|(_, n)| tangent(n, f.sense));
             if let Some(t) = ahead
                 && let Some(&(_, o)) = self
                     .normals
@@ -303,7 +303,7 @@ impl Agent {
             last: p,
             stalls: 0,
         });
-        self.run_left = exponential(&mut self.rng, walls.world.swarm.wall_following_length);
+        self.run_left = exponential(&mut self.rng, terrain.world.swarm.wall_following_length);
         true
     }
 
@@ -343,15 +343,15 @@ fn follow_heading(n: P, sense: f64, gap: f64, step: f64) -> P {
 
 /// The gap between a body at `p` and the followed `wall`, and the wall's outward normal
 /// there (for a side, the normal pointing into the arena).
-fn wall_geometry(walls: &Walls<'_>, wall: Other, p: P) -> Option<(f64, P)> {
-    let world = walls.world;
+fn wall_geometry(terrain: &Terrain<'_>, wall: Other, p: P) -> Option<(f64, P)> {
+    let world = terrain.world;
     let r = world.swarm.body_radius;
     match wall {
         Other::Obstacle(k) => {
             let k = k as usize;
-            let d = walls.distances.signed_distance(k, p)?;
+            let d = terrain.distances.signed_distance(k, p)?;
             let n = gradient_step(
-                |q| walls.distances.signed_distance(k, q).unwrap_or(f64::NAN),
+                |q| terrain.distances.signed_distance(k, q).unwrap_or(f64::NAN),
                 p,
                 FOLLOW_NORMAL_STEP,
             )?;
@@ -463,15 +463,14 @@ fn steps_per(interval: f64, dt: f64) -> u64 {
     ((interval / dt).round() as u64).max(1)
 }
 
-/// Mutable state of a run besides the physics.
 /// The world with its obstacles' distance index: what wall contacts and wall following
 /// measure (`ObstacleDistances`, bit for bit `Obstacle::signed_distance`).
-struct Walls<'w> {
+struct Terrain<'w> {
     world: &'w World,
     distances: ObstacleDistances<'w>,
 }
 
-impl<'w> Walls<'w> {
+impl<'w> Terrain<'w> {
     fn new(world: &'w World) -> Self {
         Self {
             world,
@@ -480,9 +479,10 @@ impl<'w> Walls<'w> {
     }
 }
 
+/// Mutable state of a run besides the physics.
 struct Run<'w> {
     world: &'w World,
-    walls: Walls<'w>,
+    terrain: Terrain<'w>,
     agents: Vec<Agent>,
     /// Landmarks in the order they were chosen.
     landmarks: Vec<usize>,
@@ -558,7 +558,7 @@ impl Run<'_> {
             a.escape = false;
         }
         if !a.normals.is_empty() {
-            if !a.wall_contact(&self.walls, p) {
+            if !a.wall_contact(&self.terrain, p) {
                 // A contact ends the run: turn away and draw a new run length.
                 a.follow = None;
                 if a.next_return_run(t, world.swarm.return_patience) {
@@ -586,7 +586,7 @@ impl Run<'_> {
             f.fresh = false;
             f.last = p;
             let f = *f;
-            match wall_geometry(&self.walls, f.wall, p) {
+            match wall_geometry(&self.terrain, f.wall, p) {
                 Some((gap, n)) if a.run_left > 0.0 && gap <= FOLLOW_LOST * step && !stuck => {
                     a.heading = follow_heading(n, f.sense, gap, step);
                 }
@@ -731,10 +731,12 @@ impl Run<'_> {
                     let pb = pos[b as usize];
                     (pa.0 - pb.0).hypot(pa.1 - pb.1) - 2.0 * r
                 }
-                Other::Obstacle(k) => match self.walls.distances.signed_distance(k as usize, pa) {
-                    Some(d) => d - r,
-                    None => continue,
-                },
+                Other::Obstacle(k) => {
+                    match self.terrain.distances.signed_distance(k as usize, pa) {
+                        Some(d) => d - r,
+                        None => continue,
+                    }
+                }
                 Other::Side(j) => match side_gaps(world, pa, r).get(usize::from(j)) {
                     Some(s) => s.0,
                     None => continue,
@@ -778,7 +780,7 @@ impl Run<'_> {
                     }
                 }
                 Other::Obstacle(k) => {
-                    let d = &self.walls.distances;
+                    let d = &self.terrain.distances;
                     if d.signed_distance(k as usize, pa).is_some() {
                         normals[0] =
                             gradient(|q| d.signed_distance(k as usize, q).unwrap_or(f64::NAN), pa)
@@ -875,7 +877,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     let mut scene = Scene::new(world, &start, dt);
     let mut run = Run {
         world,
-        walls: Walls::new(world),
+        terrain: Terrain::new(world),
         agents: (0..n_agents)
             .map(|i| Agent::new(opts.seed, i, world))
             .collect(),
@@ -1036,11 +1038,11 @@ mod tests {
         let mut a = Agent::new(3, 0, &world);
         a.normals.push(((0.0, 1.0), Other::Side(2)));
         let before = a.rng.clone();
-        assert!(!a.wall_contact(&Walls::new(&world), (1.0, 0.004)));
+        assert!(!a.wall_contact(&Terrain::new(&world), (1.0, 0.004)));
         assert_eq!(*a.rng, *before);
         // With a positive probability the same hit draws.
         world.swarm.wall_following = 0.5;
-        let _ = a.wall_contact(&Walls::new(&world), (1.0, 0.004));
+        let _ = a.wall_contact(&Terrain::new(&world), (1.0, 0.004));
         assert_ne!(*a.rng, *before);
     }
 }

@@ -9,14 +9,21 @@
 //! - a grid of square cells over its bounding box, each listing the edges whose bounding
 //!   box meets it. The nearest edge is searched ring by ring round the query's cell, and
 //!   the search stops once every cell not yet visited lies farther than the best distance
-//!   found (with a margin far above rounding), so the least distance is the one the full
-//!   scan computes, by the same formula ([`segment_distance`]);
+//!   found (with a margin far above rounding, scaled by the coordinates: [`STOP_MARGIN`]),
+//!   so the least distance is the one the full scan computes, by the same formula
+//!   ([`segment_distance`]). This is the uniform-grid nearest-neighbour search of
+//!   computational geometry (e.g. de Berg et al., *Computational Geometry*, 3rd ed., §5
+//!   on range searching; Samet, *Foundations of Multidimensional and Metric Data
+//!   Structures*, §1.3 on grids), with edges in place of points;
 //! - horizontal slabs, about one per edge, each listing the edges whose y-range meets it.
 //!   The even–odd test only counts edges that straddle the query's y, and every such edge
 //!   lies in the query's slab; the parity of the same crossings, by the same formula, is
 //!   the same.
 //!
-//! A query farther from the polygon than [`MAX_RINGS`] rings falls back to the full scan.
+//! A query farther from the polygon than [`MAX_RINGS`] rings falls back to the full scan,
+//! and so does every query of a polygon whose edges would fill the lists past
+//! [`PAIR_BUDGET`] entries per edge (long edges that cross much of the box: a comb of
+//! full-height teeth), so an index never costs more than O(n) memory.
 
 use super::geometry::segment_distance;
 use super::types::{Obstacle, Vec2};
@@ -27,10 +34,14 @@ pub const MIN_INDEXED_VERTICES: usize = 64;
 /// Rings of cells searched round a query before the full scan is cheaper.
 const MAX_RINGS: usize = 24;
 
-/// Relative and absolute margins by which the unvisited cells must lie beyond the best
-/// distance before the search stops: far above the rounding of the distances involved.
-const STOP_RELATIVE: f64 = 1e-9;
-const STOP_ABSOLUTE: f64 = 1e-12;
+/// The ring search stops once the unvisited cells lie farther than the best distance by
+/// this fraction of the best distance plus the coordinates' magnitude: far above the
+/// rounding of the distances and grid lines, which grows with the coordinates (in a 10 km
+/// arena one ulp is 1.8e-12 m).
+const STOP_MARGIN: f64 = 1e-9;
+
+/// Entries an index may hold per edge, in its grid's and in its slabs' lists each.
+const PAIR_BUDGET: usize = 16;
 
 /// The obstacles of a world, each polygon of [`MIN_INDEXED_VERTICES`] or more indexed.
 #[derive(Debug, Clone)]
@@ -70,6 +81,8 @@ impl<'w> ObstacleDistances<'w> {
 struct PolygonIndex {
     /// Lower-left corner of the grid, metres.
     lo: Vec2,
+    /// Largest |coordinate| of the polygon, metres: the scale of its rounding.
+    extent: f64,
     /// Side of a (square) cell, metres.
     cell: f64,
     nx: usize,
@@ -111,7 +124,9 @@ fn rect_distance(p: Vec2, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
 }
 
 impl PolygonIndex {
-    /// `None` for a polygon without extent or whose index would not fit `u32` counts.
+    /// `None` (the full scan) for a polygon without extent, or whose edges would fill the
+    /// grid's or the slabs' lists past [`PAIR_BUDGET`] per edge even after coarsening (a
+    /// comb of full-height teeth crosses every slab with every tooth).
     fn new(points: &[Vec2]) -> Option<Self> {
         let n = points.len();
         let (mut lo, mut hi) = (
@@ -123,55 +138,72 @@ impl PolygonIndex {
             hi = (hi.0.max(p.0), hi.1.max(p.1));
         }
         let (w, h) = (hi.0 - lo.0, hi.1 - lo.1);
-        if !(w.is_finite() && h.is_finite()) || w.max(h) <= 0.0 || n > (u32::MAX / 4) as usize {
+        if !(w.is_finite() && h.is_finite()) || w.max(h) <= 0.0 || n > (u32::MAX / 64) as usize {
             return None;
         }
-        // About one cell per edge; thin boxes get cells of the long side over n.
+        let budget = PAIR_BUDGET * n + 64;
+        let edges = || (0..n).map(|k| (points[k], points[(k + 1) % n]));
+        // About one cell per edge (thin boxes: cells of the long side over n), coarsened
+        // until the grid and the edges' lists fit the budget.
         let mut cell = (w * h / n as f64).sqrt().max(w.max(h) / n as f64);
-        let (mut nx, mut ny);
-        loop {
-            nx = ((w / cell).ceil() as usize).max(1);
-            ny = ((h / cell).ceil() as usize).max(1);
-            if nx.saturating_mul(ny) <= 4 * n + 16 {
+        let mut ix = None;
+        for _ in 0..64 {
+            if !(cell > 0.0 && cell.is_finite()) {
+                return None;
+            }
+            let nx = ((w / cell).ceil() as usize).max(1);
+            let ny = ((h / cell).ceil() as usize).max(1);
+            let candidate = Self {
+                lo,
+                extent: lo.0.abs().max(lo.1.abs()).max(hi.0.abs()).max(hi.1.abs()),
+                cell,
+                nx,
+                ny,
+                slab_height: 0.0,
+                slabs: 1,
+                cell_start: Vec::new(),
+                cell_edges: Vec::new(),
+                slab_start: Vec::new(),
+                slab_edges: Vec::new(),
+            };
+            let pairs = edges().try_fold(0usize, |acc, (a, b)| {
+                let cols = candidate.col(a.0.max(b.0)) - candidate.col(a.0.min(b.0)) + 1;
+                let rows = candidate.row(a.1.max(b.1)) - candidate.row(a.1.min(b.1)) + 1;
+                let acc = acc + cols * rows;
+                (acc <= budget).then_some(acc)
+            });
+            if nx.saturating_mul(ny) <= budget && pairs.is_some() {
+                ix = Some(candidate);
                 break;
             }
             cell *= 1.5;
         }
-        // Thin slabs: a slab then holds the edges crossing its height (a few for an
-        // outline) and about one more.
-        let slabs = n;
-        let mut ix = Self {
-            lo,
-            cell,
-            nx,
-            ny,
-            slab_height: h / slabs as f64,
-            slabs,
-            cell_start: Vec::new(),
-            cell_edges: Vec::new(),
-            slab_start: Vec::new(),
-            slab_edges: Vec::new(),
+        let mut ix = ix?;
+        // Thin slabs, about one per edge: a slab then holds the edges crossing its height
+        // (a few for an outline) and about one more. Edges that rise far (Σ |Δy| ≫ h) get
+        // fewer, thicker slabs, so that Σ (|Δy| / slab + 2) stays within the budget.
+        let rise: f64 = edges().map(|(a, b)| (a.1 - b.1).abs()).sum();
+        let slabs = if rise > 0.0 {
+            ((budget - 2 * n) as f64 * h / rise).clamp(1.0, n as f64) as usize
+        } else {
+            n
         };
+        ix.slabs = slabs;
+        ix.slab_height = h / slabs as f64;
         let (mut in_cells, mut in_slabs) = (Vec::new(), Vec::new());
-        for k in 0..n {
-            let (a, b) = (points[k], points[(k + 1) % n]);
+        for (k, (a, b)) in edges().enumerate() {
             let (i0, i1) = (ix.col(a.0.min(b.0)), ix.col(a.0.max(b.0)));
             let (j0, j1) = (ix.row(a.1.min(b.1)), ix.row(a.1.max(b.1)));
-            // Edges of a traced outline are short; a long edge of a coarse polygon meets
-            // many cells, bounded by the grid's 4 n + 16.
             for i in i0..=i1 {
                 for j in j0..=j1 {
-                    in_cells.push((i * ny + j, k as u32));
+                    in_cells.push((i * ix.ny + j, k as u32));
                 }
             }
             for j in ix.slab(a.1.min(b.1))..=ix.slab(a.1.max(b.1)) {
                 in_slabs.push((j, k as u32));
             }
         }
-        if in_cells.len().max(in_slabs.len()) > u32::MAX as usize {
-            return None;
-        }
-        (ix.cell_start, ix.cell_edges) = csr(nx * ny, &in_cells);
+        (ix.cell_start, ix.cell_edges) = csr(ix.nx * ix.ny, &in_cells);
         (ix.slab_start, ix.slab_edges) = csr(slabs, &in_slabs);
         Some(ix)
     }
@@ -252,7 +284,8 @@ impl PolygonIndex {
             if bound == f64::INFINITY {
                 return Some(best);
             }
-            if best.is_finite() && bound > best * (1.0 + STOP_RELATIVE) + STOP_ABSOLUTE {
+            let scale = best + p.0.abs().max(p.1.abs()).max(self.extent);
+            if best.is_finite() && bound > best + STOP_MARGIN * scale {
                 return Some(best);
             }
         }
@@ -373,6 +406,80 @@ mod tests {
             &circle,
             &[(0.0, 0.0), (1e3, -7e2), (0.3, 0.2), (-1e-9, 1.0)],
         );
+    }
+
+    #[test]
+    fn a_ten_kilometre_world_rounds_as_the_full_scan() {
+        // Found in review: a vertex on a grid line that `col` rounds into the cell before,
+        // and a query 10 000 ulps away, where the full scan's distance is one ulp short of
+        // the exact one. A fixed absolute margin (1e-12 m) is below one ulp at x ≥ 8192 m.
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/fixtures/worlds/notch_10km.ron"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let world = crate::world::parse_str(&text, path)
+            .unwrap()
+            .check()
+            .unwrap();
+        let Obstacle::Polygon { points } = &world.obstacles[0] else {
+            panic!("a polygon");
+        };
+        let b = points[1];
+        let mut queries = vec![(8647.604546142387, 5000.5), b];
+        let mut x = b.0;
+        for _ in 0..20_000 {
+            x = f64::from_bits(x.to_bits() + 1);
+            queries.push((x, b.1));
+        }
+        assert_same(points, &queries);
+    }
+
+    #[test]
+    fn long_edges_keep_the_index_within_its_budget() {
+        // A comb of full-height teeth: every horizontal line crosses every tooth.
+        let teeth = 2000;
+        let mut comb = Vec::new();
+        for t in 0..teeth {
+            let x = f64::from(t);
+            comb.extend([(x, 0.0), (x, 100.0), (x + 0.5, 100.0), (x + 0.5, 0.0)]);
+        }
+        comb.extend([
+            (f64::from(teeth), 0.0),
+            (f64::from(teeth), -1.0),
+            (0.0, -1.0),
+        ]);
+        comb.reverse();
+        let ix = PolygonIndex::new(&comb).expect("indexed");
+        let budget = PAIR_BUDGET * comb.len() + 64;
+        assert!(ix.cell_edges.len() <= budget && ix.slab_edges.len() <= budget);
+        assert!(ix.nx * ix.ny <= budget);
+        let queries: Vec<Vec2> = (0..3000)
+            .map(|i| {
+                let t = f64::from(i);
+                ((t * 0.7123) % 2003.0 - 1.0, (t * 0.377) % 103.0 - 2.0)
+            })
+            .collect();
+        assert_same(&comb, &queries);
+    }
+
+    #[test]
+    fn degenerate_polygons_are_scanned_whole() {
+        // A box whose side over n underflows to zero: no cell size, no index (this
+        // looped forever before review). Also a box of zero height and one not finite.
+        let tiny: Vec<Vec2> = (0..64u64)
+            .map(|k| (f64::from_bits(k % 4), f64::from_bits(k % 2)))
+            .collect();
+        assert!(PolygonIndex::new(&tiny).is_none());
+        let flat: Vec<Vec2> = (0..64).map(|k| (f64::from(k), 0.0)).collect();
+        let flat_index = PolygonIndex::new(&flat);
+        let huge: Vec<Vec2> = (0..64)
+            .map(|k| (if k % 2 == 0 { 1.7e308 } else { -1.7e308 }, f64::from(k)))
+            .collect();
+        assert!(PolygonIndex::new(&huge).is_none());
+        if flat_index.is_some() {
+            assert_same(&flat, &[(3.5, 0.0), (3.5, 2.0), (-4.0, -1.0), (70.0, 0.0)]);
+        }
     }
 
     #[test]

@@ -192,7 +192,8 @@ impl FreeSpaceRaster {
     /// of body radius `body` fits, sampled on its own grid (a 16th of the radius or
     /// finer, at most 2 cm, at most four million samples).
     ///
-    /// A sample counts when it lies in the disc and `World::is_free(sample, body)`; as in
+    /// A sample counts when it lies in the disc and `World::is_free(sample, body)` (for
+    /// finite distances: a NaN one blocks the sample here and is ignored there); as in
     /// [`FreeSpaceRaster::new`], each obstacle is evaluated only on the samples near its
     /// bounding box, and a polygon by edges rather than sample by sample, so a traced
     /// outline of tens of thousands of vertices costs about what its edges do (the test
@@ -221,9 +222,13 @@ impl FreeSpaceRaster {
                 free.push(inside && x.min(w - x).min(y).min(h - y) > body);
             }
         }
+        // Samples within a cell of the box grown by `body`, and by the rounding of the
+        // sample centres, which grows with the coordinates (a disc of 1e-12 m at x = 5 km
+        // has samples closer together than one ulp of x).
         let samples = |lo: f64, hi: f64, o: f64| {
-            let first = ((lo - body - o) / side - 0.5).floor() - 1.0;
-            let last = ((hi + body - o) / side - 0.5).ceil() + 1.0;
+            let slack = 1e-9 * (o.abs() + lo.abs().max(hi.abs()) + 2.0 * radius);
+            let first = ((lo - body - slack - o) / side - 0.5).floor() - 1.0;
+            let last = ((hi + body + slack - o) / side - 0.5).ceil() + 1.0;
             let first = first.max(0.0) as usize;
             let last = (last.min(n as f64 - 1.0)).max(-1.0);
             (last >= 0.0 && first as f64 <= last).then_some((first, last as usize))
@@ -331,6 +336,19 @@ mod tests {
             let slow = disc_free_area_one_by_one(&world, centre, radius, body);
             assert_eq!(fast, slow, "case {case}");
         }
+        // Found in review: a disc of 1e-12 m at x = 5 km, whose samples are closer
+        // together than the rounding of their centres, beside a rectangle one ulp away.
+        let mut world = World::empty("t", 10_000.0, 10.0);
+        let x = f64::from_bits(5000f64.to_bits() + 1);
+        world.obstacles.push(Obstacle::Rect {
+            min: (x, 0.0),
+            max: (x + 1.0, 10.0),
+        });
+        let (centre, radius, body) = ((5000.0, 5.0), 1e-12, 1e-14);
+        assert_eq!(
+            FreeSpaceRaster::disc_free_area(&world, centre, radius, body),
+            disc_free_area_one_by_one(&world, centre, radius, body)
+        );
     }
 
     #[test]

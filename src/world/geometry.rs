@@ -159,9 +159,12 @@ fn clear_polygon_cells(points: &[Vec2], margin: f64, block: CellBlock, free: &mu
     }
     // Outside: within `margin` of some edge. A centre more than a cell outside an edge's
     // box grown by `margin` is farther than `margin` from the edge.
+    // The box is also grown by the rounding of the cell centres, which grows with the
+    // coordinates (cells far smaller than one ulp of them are a disc sampler's).
     let range = |lo: f64, hi: f64, o: f64, c: f64, first: usize, last: usize| {
-        let a = ((lo - margin - o) / c - 0.5).floor() - 1.0;
-        let b = ((hi + margin - o) / c - 0.5).ceil() + 1.0;
+        let slack = 1e-9 * (o.abs() + lo.abs().max(hi.abs()));
+        let a = ((lo - margin - slack - o) / c - 0.5).floor() - 1.0;
+        let b = ((hi + margin + slack - o) / c - 0.5).ceil() + 1.0;
         let a = a.max(first as f64);
         let b = b.min(last as f64);
         (a <= b).then_some((a as usize, b as usize))
