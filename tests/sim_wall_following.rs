@@ -84,13 +84,41 @@ fn a_follower_hugs_the_arena_and_turns_its_corners() {
 
 #[test]
 fn a_follower_goes_round_an_obstacle_without_entering_it() {
-    // Agents start in the free ring round a disc; every one that reaches the disc before
-    // the arena's sides must circle it, always the same way, hugging it.
+    let (c, radius) = ((2.0, 2.0), 0.5);
+    follows_round(Obstacle::Circle { center: c, radius }, c, radius);
+}
+
+#[test]
+fn a_follower_goes_round_a_polygon_of_many_vertices_without_entering_it() {
+    // The same disc as a 720-gon (within 5 µm of the circle), wound either way: the
+    // simulator measures it through its distance index (`world::ObstacleDistances`) and
+    // makes it a one-sided polyline (64 vertices or more). Double-sided, the follower
+    // turned 30.1 rad where 32.4 were due (seed 1): the corners dragged it.
+    let (c, radius) = ((2.0, 2.0), 0.5);
+    let mut points: Vec<(f64, f64)> = (0..720)
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k) / 720.0;
+            (c.0 + radius * a.cos(), c.1 + radius * a.sin())
+        })
+        .collect();
+    follows_round(
+        Obstacle::Polygon {
+            points: points.clone(),
+        },
+        c,
+        radius,
+    );
+    points.reverse();
+    follows_round(Obstacle::Polygon { points }, c, radius);
+}
+
+/// Agents start in the free ring round a disc-like obstacle centred at `c`; every one that
+/// reaches it before the arena's sides must circle it, always the same way, hugging it.
+fn follows_round(obstacle: Obstacle, c: (f64, f64), radius: f64) {
     let mut w = still_world(4.0, 4.0, 1, 200.0);
     w.swarm.wall_following_length = 1e6;
     w.swarm.placement = swarmmap::world::Placement::Disk { radius: 0.8 };
-    let (c, radius) = ((2.0, 2.0), 0.5);
-    w.obstacles = vec![Obstacle::Circle { center: c, radius }];
+    w.obstacles = vec![obstacle];
     let step = w.swarm.speed * w.simulation.dt;
     let mut circlers = 0;
     for seed in 1..=8 {
