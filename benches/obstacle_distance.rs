@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
     for n in [200, 2_000, 40_000] {
         let obstacles = [Obstacle::Polygon { points: ring(n) }];
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-        // Outside the ring, within 5 cm of where its outermost radius is.
+        // Outside the ring, 5 mm to 5 cm radially beyond it at each angle.
         let queries: Vec<(f64, f64)> = (0..1000)
             .map(|_| {
                 let a = rng.random_range(0.0..std::f64::consts::TAU);

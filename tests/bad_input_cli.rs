@@ -340,7 +340,7 @@ fn a_campaign_refuses_the_same_run_listed_twice() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("ev");
     let dotted = format!("./{TINY}");
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 7] = [
         (&[TINY, "--seeds", "1,2,1"], "seed 1 is listed twice"),
         (
             &[TINY, TINY, "--seeds", "1"],
@@ -365,6 +365,30 @@ fn a_campaign_refuses_the_same_run_listed_twice() {
                 "swarm.agents=4",
             ],
             "--set swarm.agents is given twice",
+        ),
+        (
+            &[
+                TINY,
+                "--seeds",
+                "1",
+                "--set",
+                "swarm.agents=3,4",
+                "--set",
+                "swarm=(speed: 0.1)",
+            ],
+            "--set swarm replaces the whole of what an earlier --set swarm.agents set",
+        ),
+        (
+            &[
+                TINY,
+                "--seeds",
+                "1",
+                "--set",
+                "obstacles[00]=None",
+                "--set",
+                "obstacles[0]=None",
+            ],
+            "--set obstacles[0] is given twice",
         ),
     ];
     for (args, says) in cases {

@@ -92,9 +92,21 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
                 "--set `{s}`: the value {v} is listed twice; list each value once"
             )));
         }
-        if sweeps.iter().any(|(p, _)| *p == path) {
+        let key = super::setting_key(&path);
+        if sweeps.iter().any(|(p, _)| super::setting_key(p) == key) {
             return Err(input(anyhow!(
                 "--set {path} is given twice; give its values in one --set {path}=V1,V2,..."
+            )));
+        }
+        // Overrides apply in the order given: a section after one of its fields would drop
+        // that field's values unseen (as for run, simulate and check).
+        if let Some((p, _)) = sweeps.iter().find(|(p, _)| {
+            let k = super::setting_key(p);
+            k.starts_with(&format!("{key}.")) || k.starts_with(&format!("{key}["))
+        }) {
+            return Err(input(anyhow!(
+                "--set {path} replaces the whole of what an earlier --set {p} set, so its values \
+                 would be lost; give a section before its fields"
             )));
         }
         sweeps.push((path, values));

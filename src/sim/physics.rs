@@ -73,8 +73,8 @@ const MAX_CORRECTIVE_VELOCITY: f32 = 0.1;
 /// convex corner it slides past, which drags wall followers along fine outlines (one
 /// agent circling a 0.5 m ring for 200 s at 0.1 m/s, median speed at the wall: a circle
 /// 0.1000 m/s; 12, 63, 720 and 5 000 vertices 0.1000, 0.1000, 0.0948 and 0.0923 m/s
-/// double-sided, 0.1000 m/s at every count one-sided; `cargo run --release --example
-/// wall_speed`). The bundled and training worlds' polygons (3 to 6 vertices) stay
+/// double-sided, 0.1000 m/s at every count one-sided, the 12- and 63-gons measured in a
+/// scratch build with this threshold at 3; `cargo run --release --example wall_speed`). The bundled and training worlds' polygons (3 to 6 vertices) stay
 /// double-sided so that their runs, and the classifier fitted on them, are unchanged;
 /// making every polygon one-sided needs those re-measured (README, "Model").
 pub(crate) const ORIENTED_MIN_VERTICES: usize = 64;

@@ -20,10 +20,11 @@
 //!   lies in the query's slab; the parity of the same crossings, by the same formula, is
 //!   the same.
 //!
-//! A query farther from the polygon than [`MAX_RINGS`] rings falls back to the full scan,
-//! and so does every query of a polygon whose edges would fill the lists past
-//! [`PAIR_BUDGET`] entries per edge (long edges that cross much of the box: a comb of
-//! full-height teeth), so an index never costs more than O(n) memory.
+//! A query farther from the polygon than [`MAX_RINGS`] rings falls back to the full scan.
+//! Long edges that cross much of the box (a comb of full-height teeth) would fill the lists
+//! with O(n²) entries: the grid is coarsened and the slabs thickened until every list holds
+//! at most [`PAIR_BUDGET`] entries per edge, so an index never costs more than O(n)
+//! memory (and such a polygon's queries scan more of it).
 
 use super::geometry::segment_distance;
 use super::types::{Obstacle, Vec2};
@@ -124,9 +125,10 @@ fn rect_distance(p: Vec2, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
 }
 
 impl PolygonIndex {
-    /// `None` (the full scan) for a polygon without extent, or whose edges would fill the
-    /// grid's or the slabs' lists past [`PAIR_BUDGET`] per edge even after coarsening (a
-    /// comb of full-height teeth crosses every slab with every tooth).
+    /// The index, with a grid coarsened and slabs thickened until their lists hold at most
+    /// [`PAIR_BUDGET`] entries per edge; `None` (the full scan) for a polygon without
+    /// extent, with a box or cell size that is not finite and positive, or with more than
+    /// `u32::MAX / 64` vertices.
     fn new(points: &[Vec2]) -> Option<Self> {
         let n = points.len();
         let (mut lo, mut hi) = (
@@ -184,7 +186,13 @@ impl PolygonIndex {
         // fewer, thicker slabs, so that Σ (|Δy| / slab + 2) stays within the budget.
         let rise: f64 = edges().map(|(a, b)| (a.1 - b.1).abs()).sum();
         let slabs = if rise > 0.0 {
-            ((budget - 2 * n) as f64 * h / rise).clamp(1.0, n as f64) as usize
+            // h / rise first: finite (zero when the rise overflows), then at most n.
+            let s = (h / rise) * (budget - 2 * n) as f64;
+            if s.is_finite() {
+                s.clamp(1.0, n as f64) as usize
+            } else {
+                1
+            }
         } else {
             n
         };
@@ -477,6 +485,15 @@ mod tests {
             .map(|k| (if k % 2 == 0 { 1.7e308 } else { -1.7e308 }, f64::from(k)))
             .collect();
         assert!(PolygonIndex::new(&huge).is_none());
+        // A finite box whose total rise overflows (found in review: the slab count was
+        // NaN, so zero slabs and an out-of-bounds index).
+        let tall: Vec<Vec2> = (0..64)
+            .map(|k| (f64::from(k) * 1e-5, if k % 2 == 0 { 0.0 } else { 1e307 }))
+            .collect();
+        assert_same(
+            &tall,
+            &[(3.5, 2.0), (10.0, 5e306), (-1.0, 0.0), (70.0, 2e307)],
+        );
         if flat_index.is_some() {
             assert_same(&flat, &[(3.5, 0.0), (3.5, 2.0), (-4.0, -1.0), (70.0, 0.0)]);
         }
