@@ -781,7 +781,7 @@ impl Run<'_> {
                 }
                 Other::Obstacle(k) => {
                     let d = &self.terrain.distances;
-                    if d.signed_distance(k as usize, pa).is_some() {
+                    if (k as usize) < world.obstacles.len() {
                         normals[0] =
                             gradient(|q| d.signed_distance(k as usize, q).unwrap_or(f64::NAN), pa)
                                 .map(|n| (a as usize, n, Other::Obstacle(k)));
