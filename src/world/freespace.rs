@@ -67,19 +67,12 @@ impl FreeSpaceRaster {
                 free.push(x.min(w - x).min(y).min(h - y) > body);
             }
         }
-        let cells = |lo: f64, hi: f64, c: f64, n: usize| {
-            let first = ((lo - body) / c - 0.5).floor() - 1.0;
-            let last = ((hi + body) / c - 0.5).ceil() + 1.0;
-            // Saturating casts; a box wholly outside the raster gives an empty range.
-            let first = first.max(0.0) as usize;
-            let last = (last.min(n as f64 - 1.0)).max(-1.0);
-            (last >= 0.0).then_some((first, last as usize))
-        };
         for o in &world.obstacles {
             let (lo, hi) = o.bounding_box();
-            let (Some((x0, x1)), Some((y0, y1))) =
-                (cells(lo.0, hi.0, cx, nx), cells(lo.1, hi.1, cy, ny))
-            else {
+            let (Some((x0, x1)), Some((y0, y1))) = (
+                cells_near(lo.0, hi.0, body, 0.0, cx, nx),
+                cells_near(lo.1, hi.1, body, 0.0, cy, ny),
+            ) else {
                 continue;
             };
             let block = CellBlock {
@@ -222,22 +215,12 @@ impl FreeSpaceRaster {
                 free.push(inside && x.min(w - x).min(y).min(h - y) > body);
             }
         }
-        // Samples within a cell of the box grown by `body`, and by the rounding of the
-        // sample centres, which grows with the coordinates (a disc of 1e-12 m at x = 5 km
-        // has samples closer together than one ulp of x).
-        let samples = |lo: f64, hi: f64, o: f64| {
-            let slack = 1e-9 * (o.abs() + lo.abs().max(hi.abs()) + 2.0 * radius);
-            let first = ((lo - body - slack - o) / side - 0.5).floor() - 1.0;
-            let last = ((hi + body + slack - o) / side - 0.5).ceil() + 1.0;
-            let first = first.max(0.0) as usize;
-            let last = (last.min(n as f64 - 1.0)).max(-1.0);
-            (last >= 0.0 && first as f64 <= last).then_some((first, last as usize))
-        };
         for o in &world.obstacles {
             let (lo, hi) = o.bounding_box();
-            let (Some(cols), Some(rows)) =
-                (samples(lo.0, hi.0, origin.0), samples(lo.1, hi.1, origin.1))
-            else {
+            let (Some(cols), Some(rows)) = (
+                cells_near(lo.0, hi.0, body, origin.0, side, n),
+                cells_near(lo.1, hi.1, body, origin.1, side, n),
+            ) else {
                 continue;
             };
             clear_obstacle_cells(
@@ -253,6 +236,28 @@ impl FreeSpaceRaster {
         }
         free.iter().filter(|f| **f).count() as f64 * side * side
     }
+}
+
+/// The cells `first..=last` of a raster row or column of `n` cells of size `cell` starting
+/// at `origin` whose centres may lie within `grow` of `[lo, hi]`: one cell more on each
+/// side, and more by the rounding of the centres, which grows with the coordinates (a disc
+/// of 1e-12 m at x = 5 km has samples closer together than one ulp of x). `None` when the
+/// range is empty. Only a pruning: the cells inside are still tested one by one.
+fn cells_near(
+    lo: f64,
+    hi: f64,
+    grow: f64,
+    origin: f64,
+    cell: f64,
+    n: usize,
+) -> Option<(usize, usize)> {
+    let slack = 1e-9 * (origin.abs() + lo.abs().max(hi.abs()));
+    let first = ((lo - grow - slack - origin) / cell - 0.5).floor() - 1.0;
+    let last = ((hi + grow + slack - origin) / cell - 0.5).ceil() + 1.0;
+    // Saturating casts; a box wholly outside the raster gives an empty range.
+    let first = first.max(0.0) as usize;
+    let last = last.min(n as f64 - 1.0).max(-1.0);
+    (last >= 0.0 && first as f64 <= last).then_some((first, last as usize))
 }
 
 #[cfg(test)]
