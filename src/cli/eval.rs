@@ -100,10 +100,10 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
         }
         // Overrides apply in the order given: a section after one of its fields would drop
         // that field's values unseen (as for run, simulate and check).
-        if let Some((p, _)) = sweeps.iter().find(|(p, _)| {
-            let k = super::setting_key(p);
-            k.starts_with(&format!("{key}.")) || k.starts_with(&format!("{key}["))
-        }) {
+        if let Some((p, _)) = sweeps
+            .iter()
+            .find(|(p, _)| super::inside(&super::setting_key(p), &key))
+        {
             return Err(input(anyhow!(
                 "--set {path} replaces the whole of what an earlier --set {p} set, so its values \
                  would be lost; give a section before its fields"

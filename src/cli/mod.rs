@@ -89,11 +89,9 @@ pub fn apply_sets(spec: &mut swarmmap::world::WorldSpec, sets: &[String]) -> Res
     for assignment in sets {
         if let Some((path, _)) = assignment.split_once('=') {
             let key = setting_key(path);
-            let dropped = earlier.iter().find(|(k, _)| {
-                (*k == key && key != "obstacles.scale")
-                    || k.starts_with(&format!("{key}."))
-                    || k.starts_with(&format!("{key}["))
-            });
+            let dropped = earlier
+                .iter()
+                .find(|(k, _)| (*k == key && key != "obstacles.scale") || inside(k, &key));
             if let Some((k, first)) = dropped {
                 let what = if *k == key {
                     format!("--set {key} is given twice")
@@ -110,6 +108,14 @@ pub fn apply_sets(spec: &mut swarmmap::world::WorldSpec, sets: &[String]) -> Res
         swarmmap::world::apply_assignment(spec, assignment).map_err(input)?;
     }
     Ok(())
+}
+
+/// Whether the setting `key` lies inside the section `section` (`swarm.agents` in `swarm`,
+/// `obstacles[0]` and `obstacles.scale` in `obstacles`), both as [`setting_key`] writes them:
+/// a later `--set` of the section drops it.
+fn inside(key: &str, section: &str) -> bool {
+    key.strip_prefix(section)
+        .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
 }
 
 /// A `--set` path as compared for repeats: trimmed, each part trimmed, indices as numbers
