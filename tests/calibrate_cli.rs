@@ -132,20 +132,27 @@ fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
 }
 
 /// `--stability` needs the stabilities: a run that turns them off is refused, not fitted
-/// with a test that never bites.
+/// with a test that never bites, whether the `--set` names the field or the whole section.
 #[test]
 fn stability_without_stabilities_is_an_input_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("model.json");
-    Command::cargo_bin("swarmmap")
-        .unwrap()
-        .args(["calibrate", WORLD, "--seeds", "1", "--stability"])
-        .args(["--set", "mapping.split_stability=false", "--out"])
-        .arg(&out)
-        .assert()
-        .code(2)
-        .stderr(contains("drop `--set mapping.split_stability=false`"));
-    assert!(!out.exists(), "nothing is fitted or written");
+    for off in [
+        "mapping.split_stability=false",
+        " mapping.split_stability = false",
+        "mapping=(split_stability: false)",
+        "mapping=(windows: 5, split_stability: false)",
+    ] {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .args(["calibrate", WORLD, "--seeds", "1", "--stability"])
+            .args(["--set", off, "--out"])
+            .arg(&out)
+            .assert()
+            .code(2)
+            .stderr(contains(format!("`--set {off}` turns them off; drop it")));
+        assert!(!out.exists(), "nothing is fitted or written for {off}");
+    }
 }
 
 #[test]

@@ -1,7 +1,9 @@
 //! `swarmmap calibrate [WORLD...] [--seeds 1..5] [--set PATH=VALUE]... [--out FILE]`: fit the
 //! robust-feature classifier on training worlds and write the model file.
 
-use super::{Failure, input, load_world, refuse_repeated_worlds, reusable_build};
+use super::{
+    Failure, apply_sets, input, load_world, refuse_repeated_worlds, reusable_build, setting_key,
+};
 use anyhow::{Context, anyhow};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
@@ -15,7 +17,7 @@ use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::{Density, Feature, Model, Models};
 use swarmmap::mapping::pipeline::{MapConfig, map_windows, oracle_features, true_positions};
 use swarmmap::sim::{SimOptions, simulate};
-use swarmmap::world::{MappingMethod, World};
+use swarmmap::world::{MappingMethod, World, WorldSpec};
 
 /// Options of `swarmmap calibrate`.
 #[derive(Args, Debug)]
@@ -261,20 +263,34 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         )));
     }
     // `--stability` needs the bars' stabilities from the method's training runs (the
-    // oracle's fit has no stability test).
+    // oracle's fit has no stability test). What the `--set`s ask for is read from a spec
+    // they alone fill, so `mapping=(split_stability: false)` counts as much as
+    // `mapping.split_stability=false`.
     let mut set = args.set.clone();
     if args.stability {
-        match set
+        let mut asked = WorldSpec::default();
+        let touching: Vec<String> = set
             .iter()
-            .find(|s| s.trim_start().starts_with("mapping.split_stability"))
-        {
-            Some(s) if s.split_once('=').map(|(_, v)| v.trim()) != Some("true") => {
+            .filter(|s| {
+                s.split_once('=').is_some_and(|(path, _)| {
+                    matches!(
+                        setting_key(path).as_str(),
+                        "mapping" | "mapping.split_stability"
+                    )
+                })
+            })
+            .cloned()
+            .collect();
+        apply_sets(&mut asked, &touching)?;
+        match asked.mapping.and_then(|m| m.split_stability) {
+            Some(false) => {
+                let s = touching.last().expect("a --set gave the value");
                 return Err(input(anyhow!(
                     "--stability fits a stability test, which needs the training runs' \
-                     stabilities; drop `--set {s}`"
+                     stabilities, but `--set {s}` turns them off; drop it"
                 )));
             }
-            Some(_) => {}
+            Some(true) => {}
             None if !args.oracle => set.push("mapping.split_stability=true".to_string()),
             None => {}
         }

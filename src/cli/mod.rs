@@ -120,7 +120,7 @@ fn inside(key: &str, section: &str) -> bool {
 
 /// A `--set` path as compared for repeats: trimmed, each part trimmed, indices as numbers
 /// (`obstacles[01]` is `obstacles[1]`).
-fn setting_key(path: &str) -> String {
+pub fn setting_key(path: &str) -> String {
     path.trim()
         .split('.')
         .map(|part| {
