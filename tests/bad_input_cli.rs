@@ -34,6 +34,41 @@ fn names(dir: &Path) -> Vec<String> {
     v
 }
 
+/// A value far from the metres and seconds of a world is echoed with an exponent, not as
+/// hundreds of digits, and the numbers computed from it likewise.
+#[test]
+fn huge_and_tiny_values_are_written_with_an_exponent_in_messages() {
+    for (set, says) in [
+        ("swarm.speed=1e200", "walking at 1e200 m/s"),
+        (
+            "obstacles=[Circle(center: (1e250, 5), radius: 1)]",
+            "spans x 1e250 to 1e250, y 4 to 6 m",
+        ),
+        ("swarm.landmark_fraction=1e40", "is 1e40 (must be in [0, 1)"),
+        ("leader.window=1e20", "is 1e20 m, longer than the arena"),
+        ("leader.start_x=1e30", "is 1e30 m, outside"),
+        ("swarm.body_radius=1e30", "is 1e30 m, not below half"),
+        (
+            "swarm.wall_following=1e99",
+            "is 1e99 (must be a probability",
+        ),
+    ] {
+        let out = swarmmap()
+            .args(["check", TINY, "--set", set])
+            .assert()
+            .code(2)
+            .stderr(contains(says))
+            .get_output()
+            .stderr
+            .clone();
+        let text = String::from_utf8(out).unwrap();
+        assert!(
+            !text.contains("0000000000"),
+            "{set}: a number is written out in full: {text}"
+        );
+    }
+}
+
 #[test]
 fn world_values_the_physics_cannot_represent_are_refused() {
     swarmmap()

@@ -260,7 +260,12 @@ fn check_obstacle(
             &format!("obstacles[{i}]"),
             format!(
                 "sticks out of the arena: {what} x {} to {}, y {} to {} m, but the arena is x 0 to {}, y 0 to {} m",
-                lo.0, hi.0, lo.1, hi.1, arena.width, arena.height
+                given(lo.0),
+                given(hi.0),
+                given(lo.1),
+                given(hi.1),
+                given(arena.width),
+                given(arena.height)
             ),
             "move or shrink it so it lies inside the arena (touching the sides is allowed)",
         ));
@@ -284,6 +289,17 @@ fn collinear(points: &[Vec2]) -> bool {
         let cross = d.0 * (p.1 - p0.1) - d.1 * (p.0 - p0.0);
         cross.abs() <= 1e-9 * len2
     })
+}
+
+/// A number the user gave, exactly as Rust reads it back, but as mantissa and exponent
+/// (`1e300`, `2.5e-9`) far from the metres and seconds of a world instead of hundreds of
+/// digits.
+pub fn given(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-6..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// A computed number, rounded to 6 significant digits for messages (mantissa and exponent
@@ -427,7 +443,10 @@ impl WorldSpec {
         if !(0.0..1.0).contains(&landmark_fraction) {
             return Err(ctx.err(
                 "swarm.landmark_fraction",
-                format!("is {landmark_fraction} (must be in [0, 1): a share of the agents, and some must keep walking)"),
+                format!(
+                    "is {} (must be in [0, 1): a share of the agents, and some must keep walking)",
+                    given(landmark_fraction)
+                ),
                 "use a fraction such as the paper's 0.1",
             ));
         }
@@ -449,9 +468,11 @@ impl WorldSpec {
             return Err(ctx.err(
                 "swarm.body_radius",
                 format!(
-                    "is {body_radius} m, not below half the detection radius ({} m): two bodies keep their centres at least {} m apart, so they could never come within r_d = {detection_radius} m and no encounter would ever be recorded",
+                    "is {} m, not below half the detection radius ({} m): two bodies keep their centres at least {} m apart, so they could never come within r_d = {} m and no encounter would ever be recorded",
+                    given(body_radius),
                     short(detection_radius / 2.0),
-                    short(2.0 * body_radius)
+                    short(2.0 * body_radius),
+                    given(detection_radius)
                 ),
                 "use a body radius below r_d / 2 (the default is 0.004 with r_d = 0.01), or raise swarm.detection_radius",
             ));
@@ -488,7 +509,7 @@ impl WorldSpec {
         if !(0.0..=1.0).contains(&wall_following) {
             return Err(ctx.err(
                 "swarm.wall_following",
-                format!("is {wall_following} (must be a probability in [0, 1])"),
+                format!("is {} (must be a probability in [0, 1])", given(wall_following)),
                 "use 0 for the paper's pure random walk, 1 to follow every wall hit, or a value between",
             ));
         }
@@ -551,8 +572,9 @@ impl WorldSpec {
             return Err(ctx.err(
                 "leader.window",
                 format!(
-                    "is {window} m, longer than the arena ({} m wide)",
-                    arena.width
+                    "is {} m, longer than the arena ({} m wide)",
+                    given(window),
+                    given(arena.width)
                 ),
                 "use a window no longer than arena.width (the paper uses 3 m in a 30 m arena)",
             ));
@@ -564,7 +586,7 @@ impl WorldSpec {
             if x < xlo - tol || x > xhi + tol {
                 return Err(ctx.err(
                     field,
-                    format!("is {x} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", short(xlo), short(xhi)),
+                    format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), short(xlo), short(xhi)),
                     format!("use an x between {} and {}, or leave it out for the default", short(xlo), short(xhi)),
                 ));
             }
@@ -593,8 +615,11 @@ impl WorldSpec {
             return Err(ctx.err(
                 "simulation.dt",
                 format!(
-                    "is {dt} s: two agents walking at {speed} m/s towards each other close {} m per step, more than the detection radius {detection_radius} m, so encounters could be stepped over unseen",
-                    short(2.0 * speed * dt)
+                    "is {} s: two agents walking at {} m/s towards each other close {} m per step, more than the detection radius {} m, so encounters could be stepped over unseen",
+                    given(dt),
+                    given(speed),
+                    short(2.0 * speed * dt),
+                    given(detection_radius)
                 ),
                 format!(
                     "set simulation.dt ≤ r_d / (2·speed) = {} s (a world that sets no dt gets the default), or lower swarm.speed, or raise swarm.detection_radius",
@@ -697,7 +722,12 @@ impl WorldSpec {
         if total.is_nan() || total <= 0.0 || !total.is_finite() {
             return Err(ctx.err(
                 "leader.end_x",
-                format!("is {end_x} m and the run lasts {total} s (dispersion {dispersion_time} s plus the sweep from x = {start_x} m)"),
+                format!(
+                    "is {} m and the run lasts {total} s (dispersion {} s plus the sweep from x = {} m)",
+                    given(end_x),
+                    given(dispersion_time),
+                    given(start_x)
+                ),
                 "give the sweep a positive length (end_x ≠ start_x) or a positive simulation.dispersion_time",
             ));
         }
@@ -849,6 +879,23 @@ mod tests {
         assert_eq!(short(1e300), "1e300");
         assert_eq!(short(-2.5e39), "-2.5e39");
         assert_eq!(short(1.234567e-9), "1.23457e-9");
+    }
+
+    #[test]
+    fn given_keeps_every_digit_but_writes_far_numbers_with_an_exponent() {
+        assert_eq!(given(0.0), "0");
+        assert_eq!(given(0.1), "0.1");
+        assert_eq!(given(1.0 / 3.0), "0.3333333333333333");
+        assert_eq!(given(30.000000001), "30.000000001");
+        assert_eq!(given(123456789012345.0), "123456789012345");
+        assert_eq!(given(1e15), "1e15");
+        assert_eq!(given(1e300), "1e300");
+        assert_eq!(given(-2.5e39), "-2.5e39");
+        assert_eq!(given(1.234567e-9), "1.234567e-9");
+        assert_eq!(given(f64::INFINITY), "inf");
+        for x in [1e300, -7.25e-200, 3.0e16, 1.0 / 3.0, 5e-7] {
+            assert_eq!(given(x).parse::<f64>().unwrap(), x, "{x} reads back");
+        }
     }
 
     #[test]
