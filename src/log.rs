@@ -428,7 +428,9 @@ fn interval(row: &Row<'_>) -> Result<(f64, f64), String> {
     let (start, end) = (row.time("start")?, row.time("end")?);
     if end < start {
         return Err(format!(
-            "end {end} is before start {start}; an interval must have end >= start"
+            "end {} is before start {}; an interval must have end >= start",
+            crate::world::given(end),
+            crate::world::given(start)
         ));
     }
     Ok((start, end))
@@ -542,9 +544,12 @@ fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
             path: path.to_path_buf(),
             line: second,
             message: format!(
-                "this row puts the leader at x = {x1} m at time {time} s, but line {first} \
-                 puts it at x = {x0} m then; keep one row per time (correct or remove one; \
-                 leader.csv is optional, only the report draws it)"
+                "this row puts the leader at x = {} m at time {} s, but line {first} \
+                 puts it at x = {} m then; keep one row per time (correct or remove one; \
+                 leader.csv is optional, only the report draws it)",
+                crate::world::given(x1),
+                crate::world::given(time),
+                crate::world::given(x0)
             ),
         });
     }

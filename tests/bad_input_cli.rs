@@ -52,6 +52,23 @@ fn huge_and_tiny_values_are_written_with_an_exponent_in_messages() {
             "swarm.wall_following=1e99",
             "is 1e99 (must be a probability",
         ),
+        ("simulation.dt=1e-300", "simulation.dt is 1e-300 s, so the"),
+        (
+            "mapping.overlap=1e300",
+            "mapping.overlap is 1e300 s, not shorter",
+        ),
+        (
+            "obstacles=[Rect(min: (1e300, 1), max: (2, 2))]",
+            "max is (2, 2) but min is (1e300, 1)",
+        ),
+        (
+            "swarm.placement=Disk(radius: 1e-300)",
+            "is a disc of radius 1e-300 m around",
+        ),
+        (
+            "leader.speed=1e-320",
+            "leader.speed is 1e-320 m/s, so the sweep from x = ",
+        ),
     ] {
         let out = swarmmap()
             .args(["check", TINY, "--set", set])
@@ -67,6 +84,35 @@ fn huge_and_tiny_values_are_written_with_an_exponent_in_messages() {
             "{set}: a number is written out in full: {text}"
         );
     }
+}
+
+/// The largest time step the encounter check suggests is one it accepts: rounded down, not
+/// to the nearest (0.0166667 s would still be refused for r_d = 1 cm at 0.3 m/s).
+#[test]
+fn the_suggested_time_step_passes_the_check() {
+    let sets = [
+        "swarm.detection_radius=0.01",
+        "swarm.body_radius=0.004",
+        "swarm.speed=0.3",
+    ];
+    let check = |dt: &str| {
+        let mut c = swarmmap();
+        c.args(["check", TINY]);
+        for s in sets {
+            c.args(["--set", s]);
+        }
+        c.args(["--set", &format!("simulation.dt={dt}")]);
+        c.assert()
+    };
+    let refused = check("0.03").code(2);
+    let text = String::from_utf8(refused.get_output().stderr.clone()).unwrap();
+    let suggested = text
+        .split("set simulation.dt ≤ r_d / (2·speed) = ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .unwrap_or_else(|| panic!("no suggested time step in: {text}"));
+    assert_eq!(suggested, "0.0166666");
+    check(suggested).success();
 }
 
 #[test]

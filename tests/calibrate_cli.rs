@@ -155,6 +155,45 @@ fn stability_without_stabilities_is_an_input_error() {
     }
 }
 
+/// The forms `--stability` accepts get as far as loading the worlds (here refused for a
+/// swarm of no agents, so nothing is simulated): the default (`=None`), `true`, a whole
+/// `mapping` section that leaves the field out, and with `--oracle`, whose fit has no
+/// stability test, even `false`. Two sets that both turn it off are both named.
+#[test]
+fn stability_accepts_the_forms_that_leave_stabilities_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    for (extra, set) in [
+        (None, "mapping.split_stability=None"),
+        (None, "mapping.split_stability = true"),
+        (None, "mapping=(windows: 5)"),
+        (None, "mapping=None"),
+        (Some("--oracle"), "mapping.split_stability=false"),
+    ] {
+        let mut cmd = Command::cargo_bin("swarmmap").unwrap();
+        cmd.args(["calibrate", WORLD, "--seeds", "1", "--stability"]);
+        cmd.args(extra);
+        cmd.args(["--set", set, "--set", "swarm.agents=0", "--out"])
+            .arg(&out)
+            .assert()
+            .code(2)
+            .stderr(contains("swarm.agents is 0"));
+    }
+    Command::cargo_bin("swarmmap")
+        .unwrap()
+        .args(["calibrate", WORLD, "--seeds", "1", "--stability"])
+        .args(["--set", "mapping=(split_stability: false)"])
+        .args(["--set", "mapping.split_stability=false", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "`--set mapping=(split_stability: false)` and `--set mapping.split_stability=false` \
+             turn them off; drop them",
+        ));
+    assert!(!out.exists(), "nothing is fitted or written");
+}
+
 #[test]
 fn cross_validation_prints_every_fold_and_records_the_held_out_figures() {
     let (_dir, out) = shipped_copy();

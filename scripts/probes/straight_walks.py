@@ -39,6 +39,8 @@ def obstacle_dist(o, p):
     kind, v = next(iter(o.items()))
     if kind == "Circle":
         return max(0.0, float(np.linalg.norm(np.asarray(p) - v["center"])) - v["radius"])
+    if kind == "Wall":
+        return max(0.0, seg_dist(p, v["from"], v["to"]) - v["thickness"] / 2)
     if kind == "Rect":
         pts = [v["min"], [v["max"][0], v["min"][1]], v["max"], [v["min"][0], v["max"][1]]]
     else:

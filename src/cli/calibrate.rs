@@ -17,7 +17,7 @@ use swarmmap::io::write_atomic;
 use swarmmap::mapping::classify::{Density, Feature, Model, Models};
 use swarmmap::mapping::pipeline::{MapConfig, map_windows, oracle_features, true_positions};
 use swarmmap::sim::{SimOptions, simulate};
-use swarmmap::world::{MappingMethod, World, WorldSpec};
+use swarmmap::world::{MappingMethod, World, WorldSpec, given};
 
 /// Options of `swarmmap calibrate`.
 #[derive(Args, Debug)]
@@ -205,7 +205,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     if !(0.0..=1.0).contains(&args.max_false_holes) {
         return Err(input(anyhow!(
             "--max-false-holes is {}; it is a share of the hole-free training windows, from 0 to 1 (1 = unconstrained)",
-            args.max_false_holes
+            given(args.max_false_holes)
         )));
     }
     // Found before the training runs, not after them.
@@ -263,37 +263,50 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         )));
     }
     // `--stability` needs the bars' stabilities from the method's training runs (the
-    // oracle's fit has no stability test). What the `--set`s ask for is read from a spec
-    // they alone fill, so `mapping=(split_stability: false)` counts as much as
-    // `mapping.split_stability=false`.
+    // oracle's fit has no stability test, so `--oracle` alone leaves the sets as they are).
+    // What the `--set`s ask for is read from a spec they alone fill, so
+    // `mapping=(split_stability: false)` counts as much as `mapping.split_stability=false`.
     let mut set = args.set.clone();
-    if args.stability {
-        let mut asked = WorldSpec::default();
-        let touching: Vec<String> = set
-            .iter()
-            .filter(|s| {
-                s.split_once('=').is_some_and(|(path, _)| {
-                    matches!(
-                        setting_key(path).as_str(),
-                        "mapping" | "mapping.split_stability"
-                    )
-                })
+    if args.stability && !args.oracle {
+        let touches = |s: &String| {
+            s.split_once('=').is_some_and(|(path, _)| {
+                matches!(
+                    setting_key(path).as_str(),
+                    "mapping" | "mapping.split_stability"
+                )
             })
-            .cloned()
-            .collect();
+        };
+        let touching: Vec<String> = set.iter().filter(|s| touches(s)).cloned().collect();
+        let mut asked = WorldSpec::default();
         apply_sets(&mut asked, &touching)?;
-        match asked.mapping.and_then(|m| m.split_stability) {
-            Some(false) => {
-                let s = touching.last().expect("a --set gave the value");
-                return Err(input(anyhow!(
-                    "--stability fits a stability test, which needs the training runs' \
-                     stabilities, but `--set {s}` turns them off; drop it"
-                )));
+        if asked.mapping.and_then(|m| m.split_stability) == Some(false) {
+            let mut off: Vec<String> = touching
+                .iter()
+                .filter(|s| {
+                    let mut alone = WorldSpec::default();
+                    apply_sets(&mut alone, std::slice::from_ref(*s)).is_ok()
+                        && alone.mapping.and_then(|m| m.split_stability) == Some(false)
+                })
+                .map(|s| format!("`--set {s}`"))
+                .collect();
+            if off.is_empty() {
+                off = touching.iter().map(|s| format!("`--set {s}`")).collect();
             }
-            Some(true) => {}
-            None if !args.oracle => set.push("mapping.split_stability=true".to_string()),
-            None => {}
+            return Err(input(anyhow!(
+                "--stability fits the Embedded method's stability test, which needs the \
+                 training runs' stabilities, but {} turn{} them off; drop {}",
+                off.join(" and "),
+                if off.len() == 1 { "s" } else { "" },
+                if off.len() == 1 { "it" } else { "them" }
+            )));
         }
+        // A field-form set that leaves the default (`=None`) or asks for `true` gives way
+        // to the one appended here (two sets of one field are refused as a lost value).
+        set.retain(|s| {
+            s.split_once('=')
+                .is_none_or(|(path, _)| setting_key(path) != "mapping.split_stability")
+        });
+        set.push("mapping.split_stability=true".to_string());
     }
     let worlds: Vec<World> = paths
         .iter()
@@ -310,9 +323,9 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             "the training worlds sweep at different speeds ({}: {} m/s, {}: {} m/s); a model \
              is fitted at one sweep: give them one with --set leader.speed=V",
             paths[0].display(),
-            sweep,
+            given(sweep),
             p.display(),
-            w.leader.speed
+            given(w.leader.speed)
         )));
     }
     // The fits each run feeds: the method's, the oracle's, or both.
@@ -510,7 +523,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             input(anyhow!(
                 "no classifier shows false holes in at most {} of the {} training windows \
                  without a hole; allow more with --max-false-holes",
-                args.max_false_holes,
+                given(args.max_false_holes),
                 samples.iter().filter(|s| s.truth[1] == 0).count()
             ))
         })?;
@@ -594,7 +607,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
                 ""
             },
             args.seeds,
-            args.max_false_holes,
+            given(args.max_false_holes),
             args.cross_validate
                 .iter()
                 .map(|g| format!("--cross-validate {} ", g.value()))

@@ -104,7 +104,8 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     if let Some(o) = args.overlap {
         if !(o.is_finite() && o >= 0.0) {
             return Err(input(anyhow::anyhow!(
-                "--overlap must be a non-negative number of seconds, got {o}"
+                "--overlap must be a non-negative number of seconds, got {}",
+                swarmmap::world::given(o)
             )));
         }
         cfg.overlap = o;

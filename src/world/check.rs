@@ -107,7 +107,11 @@ impl Ctx<'_> {
         } else {
             Err(self.err(
                 field,
-                format!("is ({}, {}) (coordinates must be finite numbers)", p.0, p.1),
+                format!(
+                    "is ({}, {}) (coordinates must be finite numbers)",
+                    given(p.0),
+                    given(p.1)
+                ),
                 "give finite coordinates in metres",
             ))
         }
@@ -136,7 +140,7 @@ pub fn landmark_count(fraction: f64, agents: usize) -> usize {
 }
 
 fn fmt_pt(p: Vec2) -> String {
-    format!("({}, {})", p.0, p.1)
+    format!("({}, {})", given(p.0), given(p.1))
 }
 
 fn check_obstacle(
@@ -302,6 +306,51 @@ pub fn given(x: f64) -> String {
     }
 }
 
+/// A bound that a value may reach from below (a largest time step, the right end of a
+/// range), rounded down to 6 significant digits, or exactly ([`given`]) where that
+/// rounding does not land at or under it. Either way a user who copies the number gets a
+/// value the check accepts.
+fn short_at_most(bound: f64) -> String {
+    rounded_within(bound, f64::floor, |v| v <= bound)
+}
+
+/// A bound that a value may reach from above (the left end of a range), rounded up to 6
+/// significant digits, or exactly ([`given`]) where that rounding does not land at or over it.
+fn short_at_least(bound: f64) -> String {
+    rounded_within(bound, f64::ceil, |v| v >= bound)
+}
+
+fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> bool) -> String {
+    if bound == 0.0 || !bound.is_finite() {
+        return given(bound);
+    }
+    let trim = |s: String| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let e = bound.abs().log10().floor() as i32;
+    let s = if (1e-6..1e9).contains(&bound.abs()) {
+        let digits = (5 - e).max(0);
+        let scale = 10f64.powi(digits);
+        trim(format!(
+            "{:.*}",
+            digits as usize,
+            round(bound * scale) / scale
+        ))
+    } else {
+        // Mantissa and exponent, as `short` writes them.
+        let mantissa = round(bound / 10f64.powi(e) * 1e5) / 1e5;
+        format!("{}e{e}", trim(format!("{mantissa:.5}")))
+    };
+    match s.parse::<f64>() {
+        Ok(v) if inside(v) => s,
+        _ => given(bound),
+    }
+}
+
 /// A computed number, rounded to 6 significant digits for messages (mantissa and exponent
 /// far from 1).
 pub fn short(x: f64) -> String {
@@ -386,7 +435,7 @@ impl WorldSpec {
             if v > MAX_ARENA_SIDE {
                 return Err(ctx.err(
                     field,
-                    format!("is {} m, more than {MAX_ARENA_SIDE} m: the physics engine works in single precision, which cannot place centimetre-sized agents that far from the origin", short(v)),
+                    format!("is {} m, more than {MAX_ARENA_SIDE} m: the physics engine works in single precision, which cannot place centimetre-sized agents that far from the origin", given(v)),
                     "use an arena of at most 10 km a side (the paper's is 30 m × 10 m)",
                 ));
             }
@@ -429,8 +478,8 @@ impl WorldSpec {
                 "swarm.detection_radius",
                 format!(
                     "is {} m, more than the arena's diagonal ({} m): every pair of agents would be in contact all the time",
-                    short(detection_radius),
-                    short(diagonal)
+                    given(detection_radius),
+                    given(diagonal)
                 ),
                 "use a detection radius well below the arena's size (the paper's r_d is 0.01 m)",
             ));
@@ -470,7 +519,7 @@ impl WorldSpec {
                 format!(
                     "is {} m, not below half the detection radius ({} m): two bodies keep their centres at least {} m apart, so they could never come within r_d = {} m and no encounter would ever be recorded",
                     given(body_radius),
-                    short(detection_radius / 2.0),
+                    given(detection_radius / 2.0),
                     short(2.0 * body_radius),
                     given(detection_radius)
                 ),
@@ -586,8 +635,8 @@ impl WorldSpec {
             if x < xlo - tol || x > xhi + tol {
                 return Err(ctx.err(
                     field,
-                    format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), short(xlo), short(xhi)),
-                    format!("use an x between {} and {}, or leave it out for the default", short(xlo), short(xhi)),
+                    format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), given(xlo), given(xhi)),
+                    format!("use an x between {} and {}, or leave it out for the default", short_at_least(xlo), short_at_most(xhi)),
                 ));
             }
             Ok(x.clamp(xlo, xhi))
@@ -618,12 +667,12 @@ impl WorldSpec {
                     "is {} s: two agents walking at {} m/s towards each other close {} m per step, more than the detection radius {} m, so encounters could be stepped over unseen",
                     given(dt),
                     given(speed),
-                    short(2.0 * speed * dt),
+                    given(2.0 * speed * dt),
                     given(detection_radius)
                 ),
                 format!(
                     "set simulation.dt ≤ r_d / (2·speed) = {} s (a world that sets no dt gets the default), or lower swarm.speed, or raise swarm.detection_radius",
-                    short(detection_radius / (2.0 * speed))
+                    short_at_most(detection_radius / (2.0 * speed))
                 ),
             ));
         }
@@ -718,6 +767,18 @@ impl WorldSpec {
         };
 
         // Durations.
+        if !world.sweep_duration().is_finite() {
+            return Err(ctx.err(
+                "leader.speed",
+                format!(
+                    "is {} m/s, so the sweep from x = {} to {} m would never end",
+                    given(world.leader.speed),
+                    given(start_x),
+                    given(end_x)
+                ),
+                "give the leader a speed such as the paper's 0.005 m/s",
+            ));
+        }
         let total = world.total_duration();
         if total.is_nan() || total <= 0.0 || !total.is_finite() {
             return Err(ctx.err(
@@ -735,7 +796,8 @@ impl WorldSpec {
             return Err(ctx.err(
                 "simulation.dt",
                 format!(
-                    "is {dt} s, so the {} s run needs {:.3e} steps (at most {MAX_STEPS:e} allowed)",
+                    "is {} s, so the {} s run needs {:.3e} steps (at most {MAX_STEPS:e} allowed)",
+                    given(dt),
                     if total < 1e9 {
                         short(total)
                     } else {
@@ -750,8 +812,16 @@ impl WorldSpec {
         if overlap >= window_duration {
             return Err(ctx.err(
                 "mapping.overlap",
-                format!("is {overlap} s, not shorter than one window ({} s = {} s run / {windows} windows)", short(window_duration), short(total)),
-                format!("use an overlap Δt below {} s, or fewer windows", short(window_duration)),
+                format!(
+                    "is {} s, not shorter than one window ({} s = {} s run / {windows} windows)",
+                    given(overlap),
+                    short(window_duration),
+                    short(total)
+                ),
+                format!(
+                    "use an overlap Δt below {} s, or fewer windows",
+                    short(window_duration)
+                ),
             ));
         }
 
@@ -773,14 +843,14 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
             if free <= 0.0 {
                 return Err(ctx.err(
                     "swarm.placement",
-                    format!("is a disc of radius {radius} m around ({xs}, {}) with no free space for an agent of body radius {body} m", h / 2.0),
+                    format!("is a disc of radius {} m around ({}, {}) with no free space for an agent of body radius {} m", given(radius), given(xs), given(h / 2.0), given(body)),
                     "enlarge the disc, use `Window`, or move leader.start_x or the obstacles",
                 ));
             }
             if free < need {
                 return Err(ctx.err(
                     "swarm.placement",
-                    format!("is a disc of radius {radius} m around ({xs}, {}) with only {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", h / 2.0, world.swarm.agents),
+                    format!("is a disc of radius {} m around ({}, {}) with only {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {} m need", given(radius), given(xs), given(h / 2.0), world.swarm.agents, given(body)),
                     "enlarge the disc, use `Window`, or use fewer agents",
                 ));
             }
@@ -793,7 +863,7 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
         if free < need.max(f64::MIN_POSITIVE) {
             return Err(ctx.err(
                 "swarm.placement",
-                format!("is the initial window x {} to {} m, which has {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {body} m need", short(xs - half), short(xs + half), world.swarm.agents),
+                format!("is the initial window x {} to {} m, which has {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {} m need", short(xs - half), short(xs + half), world.swarm.agents, given(body)),
                 "clear space in the first window, move leader.start_x, widen leader.window, or use fewer agents",
             ));
         }
@@ -812,7 +882,8 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
         return Err(ctx.err(
             "obstacles",
             format!(
-                "leave no free space for an agent of body radius {body} m in the leader's window around x = {x:.2} m (D(t) = x {:.2} to {:.2} m); it is blocked by {}",
+                "leave no free space for an agent of body radius {} m in the leader's window around x = {x:.2} m (D(t) = x {:.2} to {:.2} m); it is blocked by {}",
+                given(body),
                 x - half,
                 x + half,
                 if blockers.is_empty() { "the arena's sides".to_string() } else { blockers.join(", ") }
@@ -895,6 +966,35 @@ mod tests {
         assert_eq!(given(f64::INFINITY), "inf");
         for x in [1e300, -7.25e-200, 3.0e16, 1.0 / 3.0, 5e-7] {
             assert_eq!(given(x).parse::<f64>().unwrap(), x, "{x} reads back");
+        }
+    }
+
+    #[test]
+    fn bounds_are_rounded_towards_the_side_the_check_accepts() {
+        assert_eq!(short_at_most(0.01 / (2.0 * 0.3)), "0.0166666");
+        assert_eq!(short_at_least(0.01 / (2.0 * 0.3)), "0.0166667");
+        assert_eq!(short_at_most(28.5), "28.5");
+        assert_eq!(short_at_least(1.5), "1.5");
+        assert_eq!(short_at_most(2.0 / 3.0), "0.666666");
+        assert_eq!(short_at_least(2.0 / 3.0), "0.666667");
+        assert_eq!(short_at_most(5e-202), "5e-202");
+        assert_eq!(short_at_most(0.1 / (2.0 * 1e200)), "5e-202");
+        assert_eq!(short_at_least(2.0 / 3.0 * 1e300), "6.66667e299");
+        assert_eq!(short_at_most(2.0 / 3.0 * 1e300), "6.66666e299");
+        for x in [
+            1.0 / 3.0,
+            2.0 / 7.0,
+            1234.56789,
+            0.05,
+            9.99999999,
+            1e-6 * 1.2345678,
+            1.0 / 3.0 * 1e-250,
+            7.0 / 3.0 * 1e250,
+            -2.0 / 3.0,
+            f64::MIN_POSITIVE,
+        ] {
+            assert!(short_at_most(x).parse::<f64>().unwrap() <= x, "{x}");
+            assert!(short_at_least(x).parse::<f64>().unwrap() >= x, "{x}");
         }
     }
 

@@ -1,7 +1,7 @@
 //! Loading a world from a file, the time windows of the mapping (paper §"Dynamic
 //! Topological Mapping", eq. for W_i), and the short summary `swarmmap check` prints.
 
-use super::check::landmark_count;
+use super::check::{given, landmark_count};
 use super::error::WorldError;
 use super::freespace::FreeSpaceRaster;
 use super::spec::{WorldSpec, parse_str};
@@ -93,7 +93,7 @@ impl World {
         let sw = &self.swarm;
         let landmarks = landmark_count(sw.landmark_fraction, sw.agents);
         let placement = match sw.placement {
-            Placement::Disk { radius } => format!("a disc of radius {radius} m"),
+            Placement::Disk { radius } => format!("a disc of radius {} m", given(radius)),
             Placement::Window => "the initial window".to_string(),
         };
         let raster = FreeSpaceRaster::new(self, sw.body_radius);
@@ -102,8 +102,8 @@ impl World {
         let _ = writeln!(
             s,
             "arena      {} m × {} m (x along the sweep), free for agent centres: {:.1} % in {} connected region(s) ({:.0} mm raster)",
-            self.arena.width,
-            self.arena.height,
+            given(self.arena.width),
+            given(self.arena.height),
             100.0 * raster.free_area() / area,
             raster.components(),
             1000.0 * raster.cx.max(raster.cy)
@@ -123,31 +123,35 @@ impl World {
             "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in {}",
             sw.agents,
             landmarks,
-            100.0 * sw.landmark_fraction,
-            sw.detection_radius,
-            sw.speed,
-            sw.body_radius,
+            given(100.0 * sw.landmark_fraction),
+            given(sw.detection_radius),
+            given(sw.speed),
+            given(sw.body_radius),
             placement
         );
         let l = &self.leader;
         let _ = writeln!(
             s,
             "leader     sweeps x {} → {} m at {} m/s, window l = {} m",
-            l.start_x, l.end_x, l.speed, l.window
+            given(l.start_x),
+            given(l.end_x),
+            given(l.speed),
+            given(l.window)
         );
         let _ = writeln!(
             s,
             "time       dispersion {} s + sweep {} s = {} s, dt = {} s ({} steps)",
-            self.simulation.dispersion_time,
-            self.sweep_duration(),
-            self.total_duration(),
-            self.simulation.dt,
+            given(self.simulation.dispersion_time),
+            given(self.sweep_duration()),
+            given(self.total_duration()),
+            given(self.simulation.dt),
             (self.total_duration() / self.simulation.dt).ceil()
         );
         let _ = writeln!(
             s,
             "windows    {} with overlap Δt = {} s:",
-            self.mapping.windows, self.mapping.overlap
+            self.mapping.windows,
+            given(self.mapping.overlap)
         );
         for (i, span) in self.window_spans().iter().enumerate() {
             let (x0, x1) = self.span_domain(*span);
@@ -166,8 +170,8 @@ impl World {
             s,
             "mapping    {:?} method, switch cost {} s, c = {}, m = {}, k = {}; {}; {}{}",
             m.method,
-            m.switch_cost,
-            m.cluster_cutoff,
+            given(m.switch_cost),
+            given(m.cluster_cutoff),
             m.subsample,
             m.neighbours,
             if m.after_landmarks {

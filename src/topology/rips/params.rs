@@ -49,6 +49,7 @@ impl RipsOptions {
 pub enum RipsError {
     #[error("homology dimension {0} is not supported; use --maxdim 0 or 1")]
     MaxDim(usize),
-    #[error("threshold {0} is not a finite non-negative distance")]
+    // `{:?}` writes a far number with an exponent (`-1e300`), not hundreds of digits.
+    #[error("threshold {0:?} is not a finite non-negative distance")]
     Threshold(f64),
 }
