@@ -679,9 +679,23 @@ fn interval<'r>(get: &dyn Fn(&str) -> &'r str) -> Result<(f64, f64), Vec<String>
     let start = number("start", get("start"), MAX_TIME)?;
     let end = number("end", get("end"), MAX_TIME)?;
     if end < start {
-        return Err(vec![format!("end {end} is before start {start}")]);
+        return Err(vec![format!(
+            "end {} is before start {}",
+            as_written(end),
+            as_written(start)
+        )]);
     }
     Ok((start, end))
+}
+
+/// A number as messages write it (README, "Errors"): exactly, with an exponent outside
+/// 1e-6 ≤ |x| < 1e15.
+fn as_written(x: f64) -> String {
+    if x == 0.0 || (1e-6..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// The oracle: what `read_dir` must give for the table, written here from the documented
