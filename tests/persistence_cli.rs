@@ -155,6 +155,12 @@ fn bad_files_name_the_line_and_exit_2() {
         &["--threshold", "-1"],
         "threshold -1 is not a finite non-negative distance",
     );
+    // A far number is echoed with an exponent, not as hundreds of digits.
+    bad(
+        "0,0\n",
+        &["--threshold", "-1e300"],
+        "threshold -1e300 is not a finite non-negative distance",
+    );
 }
 
 /// A missing file named on the command line is bad input (status 2), as for `check` and

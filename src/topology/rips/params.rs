@@ -44,12 +44,22 @@ impl RipsOptions {
     }
 }
 
+/// A number as the command line's messages write it (as `world::given` does; the topology
+/// engine depends on no other module): exactly, with an exponent outside 1e-6 ≤ |x| < 1e15
+/// (`-1e300`, not hundreds of digits).
+fn written(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-6..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// What is wrong with a request for a persistence diagram.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum RipsError {
     #[error("homology dimension {0} is not supported; use --maxdim 0 or 1")]
     MaxDim(usize),
-    // `{:?}` writes a far number with an exponent (`-1e300`), not hundreds of digits.
-    #[error("threshold {0:?} is not a finite non-negative distance")]
+    #[error("threshold {} is not a finite non-negative distance", written(*.0))]
     Threshold(f64),
 }
