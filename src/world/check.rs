@@ -306,18 +306,17 @@ pub fn given(x: f64) -> String {
     }
 }
 
-/// A bound that a value may reach from below (a largest time step, the right end of a
-/// range), rounded down to 6 significant digits, or exactly ([`given`]) where that
-/// rounding does not land at or under it. Either way a user who copies the number gets a
-/// value the check accepts.
-fn short_at_most(bound: f64) -> String {
-    rounded_within(bound, f64::floor, |v| v <= bound)
-}
-
-/// A bound that a value may reach from above (the left end of a range), rounded up to 6
-/// significant digits, or exactly ([`given`]) where that rounding does not land at or over it.
-fn short_at_least(bound: f64) -> String {
-    rounded_within(bound, f64::ceil, |v| v >= bound)
+/// A bound to suggest in a message, as short as the check lets it be: [`short`] (rounded
+/// to nearest) where the check `accepts` that value, else rounded toward the inside to 6
+/// significant digits (`round` is `f64::floor` for an upper bound, `f64::ceil` for a lower
+/// one) where it accepts that, else exactly ([`given`]). Either way a user who copies the
+/// number gets a value the check accepts.
+fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> String {
+    let nearest = short(bound);
+    if nearest.parse::<f64>().is_ok_and(&accepts) {
+        return nearest;
+    }
+    rounded_within(bound, round, accepts)
 }
 
 fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> bool) -> String {
@@ -636,7 +635,11 @@ impl WorldSpec {
                 return Err(ctx.err(
                     field,
                     format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), given(xlo), given(xhi)),
-                    format!("use an x between {} and {}, or leave it out for the default", short_at_least(xlo), short_at_most(xhi)),
+                    format!(
+                        "use an x between {} and {}, or leave it out for the default",
+                        suggest(xlo, f64::ceil, |v| v >= xlo - tol),
+                        suggest(xhi, f64::floor, |v| v <= xhi + tol)
+                    ),
                 ));
             }
             Ok(x.clamp(xlo, xhi))
@@ -672,7 +675,9 @@ impl WorldSpec {
                 ),
                 format!(
                     "set simulation.dt ≤ r_d / (2·speed) = {} s (a world that sets no dt gets the default), or lower swarm.speed, or raise swarm.detection_radius",
-                    short_at_most(detection_radius / (2.0 * speed))
+                    suggest(detection_radius / (2.0 * speed), f64::floor, |v| {
+                        2.0 * speed * v <= detection_radius * (1.0 + 1e-9)
+                    })
                 ),
             ));
         }
@@ -971,16 +976,26 @@ mod tests {
 
     #[test]
     fn bounds_are_rounded_towards_the_side_the_check_accepts() {
-        assert_eq!(short_at_most(0.01 / (2.0 * 0.3)), "0.0166666");
-        assert_eq!(short_at_least(0.01 / (2.0 * 0.3)), "0.0166667");
-        assert_eq!(short_at_most(28.5), "28.5");
-        assert_eq!(short_at_least(1.5), "1.5");
-        assert_eq!(short_at_most(2.0 / 3.0), "0.666666");
-        assert_eq!(short_at_least(2.0 / 3.0), "0.666667");
-        assert_eq!(short_at_most(5e-202), "5e-202");
-        assert_eq!(short_at_most(0.1 / (2.0 * 1e200)), "5e-202");
-        assert_eq!(short_at_least(2.0 / 3.0 * 1e300), "6.66667e299");
-        assert_eq!(short_at_most(2.0 / 3.0 * 1e300), "6.66666e299");
+        let at_most = |x: f64| suggest(x, f64::floor, |v| v <= x);
+        let at_least = |x: f64| suggest(x, f64::ceil, |v| v >= x);
+        assert_eq!(at_most(0.01 / (2.0 * 0.3)), "0.0166666");
+        assert_eq!(at_least(0.01 / (2.0 * 0.3)), "0.0166667");
+        assert_eq!(at_most(28.5), "28.5");
+        assert_eq!(at_least(1.5), "1.5");
+        assert_eq!(at_most(2.0 / 3.0), "0.666666");
+        assert_eq!(at_least(2.0 / 3.0), "0.666667");
+        assert_eq!(at_most(5e-202), "5e-202");
+        assert_eq!(at_most(0.1 / (2.0 * 1e200)), "5e-202");
+        assert_eq!(at_least(2.0 / 3.0 * 1e300), "6.66667e299");
+        assert_eq!(at_most(2.0 / 3.0 * 1e300), "6.66666e299");
+        // Nearest first where the check accepts it: 0.01 / 0.2 is 0.049999999999999996 in
+        // f64, and the time-step check accepts 0.05 within its tolerance.
+        let (r_d, v) = (0.01, 0.1);
+        assert_eq!(
+            suggest(r_d / (2.0 * v), f64::floor, |x| 2.0 * v * x
+                <= r_d * (1.0 + 1e-9)),
+            "0.05"
+        );
         for x in [
             1.0 / 3.0,
             2.0 / 7.0,
@@ -993,8 +1008,8 @@ mod tests {
             -2.0 / 3.0,
             f64::MIN_POSITIVE,
         ] {
-            assert!(short_at_most(x).parse::<f64>().unwrap() <= x, "{x}");
-            assert!(short_at_least(x).parse::<f64>().unwrap() >= x, "{x}");
+            assert!(at_most(x).parse::<f64>().unwrap() <= x, "{x}");
+            assert!(at_least(x).parse::<f64>().unwrap() >= x, "{x}");
         }
     }
 
