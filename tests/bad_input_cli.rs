@@ -115,6 +115,72 @@ fn the_suggested_time_step_passes_the_check() {
     check(suggested).success();
 }
 
+/// Every bound a message proposes is one the check accepts: both ends of the leader's range
+/// when the window nearly fills the arena (once two backwards values), and the largest
+/// overlap when one window lasts 814.2857… s (once rounded up to 814.286).
+#[test]
+fn suggested_ranges_and_overlaps_pass_the_check() {
+    let narrow = [
+        "obstacles=[]",
+        "arena.width=7.777777",
+        "leader.window=7.777776",
+    ];
+    let check = |sets: &[&str], last: String| {
+        let mut c = swarmmap();
+        c.args(["check", TINY]);
+        for s in sets {
+            c.args(["--set", s]);
+        }
+        c.args(["--set", &last]);
+        c.output().unwrap()
+    };
+    let out = check(&narrow, "leader.start_x=0".into());
+    let text = String::from_utf8(out.stderr).unwrap();
+    let range = text
+        .split("use an x between ")
+        .nth(1)
+        .and_then(|r| r.split(", or leave").next())
+        .unwrap_or_else(|| panic!("no range in: {text}"));
+    let (lo, hi) = range.split_once(" and ").unwrap();
+    assert!(
+        lo.parse::<f64>().unwrap() <= hi.parse::<f64>().unwrap(),
+        "{range}"
+    );
+    for x in [lo, hi] {
+        let o = check(&narrow, format!("leader.start_x={x}"));
+        let e = String::from_utf8(o.stderr).unwrap();
+        assert!(!e.contains("leader.start_x is"), "{x} refused: {e}");
+    }
+
+    let seven = ["mapping.windows=7", "simulation.dispersion_time=300"];
+    let mut c = swarmmap();
+    c.args(["check", "worlds/scenario2.ron"]);
+    for s in seven {
+        c.args(["--set", s]);
+    }
+    let text = String::from_utf8(
+        c.args(["--set", "mapping.overlap=900"])
+            .output()
+            .unwrap()
+            .stderr,
+    )
+    .unwrap();
+    let below = text
+        .split("use an overlap Δt below ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap_or_else(|| panic!("no overlap bound in: {text}"));
+    assert_eq!(below, "814.285");
+    let mut c = swarmmap();
+    c.args(["check", "worlds/scenario2.ron"]);
+    for s in seven {
+        c.args(["--set", s]);
+    }
+    c.args(["--set", &format!("mapping.overlap={below}")])
+        .assert()
+        .success();
+}
+
 #[test]
 fn world_values_the_physics_cannot_represent_are_refused() {
     swarmmap()

@@ -689,9 +689,9 @@ fn interval<'r>(get: &dyn Fn(&str) -> &'r str) -> Result<(f64, f64), Vec<String>
 }
 
 /// A number as messages write it (README, "Errors"): exactly, with an exponent outside
-/// 1e-6 ≤ |x| < 1e15.
+/// 1e-6 ≤ |x| < 1e9.
 fn as_written(x: f64) -> String {
-    if x == 0.0 || (1e-6..1e15).contains(&x.abs()) {
+    if x == 0.0 || (1e-6..1e9).contains(&x.abs()) {
         format!("{x}")
     } else {
         format!("{x:e}")

@@ -65,8 +65,9 @@ pub struct CalibrateArgs {
     /// Also search a least split stability for H1 (`h1_stability`: the life, in σ, of the
     /// weaker of the loops that the two halves of a window's encounters show at a hole's
     /// place, "Mapping"), for the `Embedded` method; implies `--set
-    /// mapping.split_stability=true` for the training runs; a stability test is kept only
-    /// where it scores more than none.
+    /// mapping.split_stability=true` for the training runs (refused with a `--set` that turns
+    /// it off; nothing with `--oracle` alone, whose fit has no stability test); a stability
+    /// test is kept only where it scores more than none.
     #[arg(long)]
     pub stability: bool,
     /// Also estimate the fit's accuracy on windows it was not fitted on: hold out each seed

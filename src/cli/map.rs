@@ -160,11 +160,11 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             "{whose} is {} s, not shorter than one window ({} s = {} s of log / {} windows), \
              so every window would span the whole log; pass --overlap below {} s, or fewer \
              --windows",
-            short(cfg.overlap),
+            swarmmap::world::given(cfg.overlap),
             short(length),
             short(cfg.span.1 - cfg.span.0),
             cfg.windows,
-            short(length),
+            swarmmap::world::suggest(length, f64::floor, |v| v <= length),
         )));
     }
     if let Some(method) = args.method {

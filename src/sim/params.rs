@@ -176,14 +176,14 @@ pub struct SimOutput {
 pub enum SimError {
     /// A world parameter the simulator depends on is out of range (a validated world never
     /// has one; hand-built worlds may).
-    #[error("world parameter `{field}` is {value}: {expected}")]
+    #[error("world parameter `{field}` is {}: {expected}", crate::world::given(*value))]
     InvalidWorld {
         field: &'static str,
         value: f64,
         expected: &'static str,
     },
     /// A run option is out of range.
-    #[error("option `{option}` is {value:?}: {expected}")]
+    #[error("option `{option}` is {}: {expected}", crate::world::given(*value))]
     InvalidOption {
         option: &'static str,
         value: f64,

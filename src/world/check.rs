@@ -88,7 +88,7 @@ impl Ctx<'_> {
             } else {
                 format!(" {unit}")
             };
-            Err(self.err(field, format!("is {} (must be > 0{unit})", short(v)), fix))
+            Err(self.err(field, format!("is {} (must be > 0{unit})", given(v)), fix))
         }
     }
 
@@ -97,7 +97,7 @@ impl Ctx<'_> {
         if v >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err(field, format!("is {} (must be ≥ 0 {unit})", short(v)), fix))
+            Err(self.err(field, format!("is {} (must be ≥ 0 {unit})", given(v)), fix))
         }
     }
 
@@ -299,7 +299,7 @@ fn collinear(points: &[Vec2]) -> bool {
 /// (`1e300`, `2.5e-9`) far from the metres and seconds of a world instead of hundreds of
 /// digits.
 pub fn given(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-6..1e15).contains(&x.abs()) {
+    if x == 0.0 || !x.is_finite() || (1e-6..1e9).contains(&x.abs()) {
         format!("{x}")
     } else {
         format!("{x:e}")
@@ -311,7 +311,7 @@ pub fn given(x: f64) -> String {
 /// significant digits (`round` is `f64::floor` for an upper bound, `f64::ceil` for a lower
 /// one) where it accepts that, else exactly ([`given`]). Either way a user who copies the
 /// number gets a value the check accepts.
-fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> String {
+pub fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> String {
     let nearest = short(bound);
     if nearest.parse::<f64>().is_ok_and(&accepts) {
         return nearest;
@@ -320,33 +320,69 @@ fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> 
 }
 
 fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> bool) -> String {
-    if bound == 0.0 || !bound.is_finite() {
-        return given(bound);
-    }
-    let trim = |s: String| {
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
+    if bound.is_normal() {
+        let trim = |s: String| {
+            if s.contains('.') {
+                s.trim_end_matches('0').trim_end_matches('.').to_string()
+            } else {
+                s
+            }
+        };
+        // The decimal exponent as Rust writes it (`{:e}`), not `log10().floor()`, which
+        // can be one off next to a power of ten.
+        let sci = format!("{bound:e}");
+        let (mantissa, e) = sci
+            .split_once('e')
+            .and_then(|(m, e)| Some((m.parse::<f64>().ok()?, e.parse::<i32>().ok()?)))
+            .unwrap_or((bound, 0));
+        let s = if (1e-6..1e9).contains(&bound.abs()) {
+            let digits = (5 - e).max(0);
+            let scale = 10f64.powi(digits);
+            trim(format!(
+                "{:.*}",
+                digits as usize,
+                round(bound * scale) / scale
+            ))
         } else {
-            s
+            // Mantissa and exponent, as `short` writes them; a mantissa rounded up to 10
+            // moves to the next exponent.
+            let rounded = round(mantissa * 1e5) / 1e5;
+            let (m, e) = if rounded.abs() >= 10.0 {
+                (rounded / 10.0, e + 1)
+            } else {
+                (rounded, e)
+            };
+            format!("{}e{e}", trim(format!("{m:.5}")))
+        };
+        if s.parse::<f64>().is_ok_and(&inside) {
+            return s;
         }
-    };
-    let e = bound.abs().log10().floor() as i32;
-    let s = if (1e-6..1e9).contains(&bound.abs()) {
-        let digits = (5 - e).max(0);
-        let scale = 10f64.powi(digits);
-        trim(format!(
-            "{:.*}",
-            digits as usize,
-            round(bound * scale) / scale
-        ))
+    }
+    // Exactly, or the nearest value inward that the check accepts (a bound computed in
+    // floating point, a subnormal one above all, may itself fall just outside).
+    let step: fn(f64) -> f64 = if round(0.5) == 0.0 {
+        f64::next_down
     } else {
-        // Mantissa and exponent, as `short` writes them.
-        let mantissa = round(bound / 10f64.powi(e) * 1e5) / 1e5;
-        format!("{}e{e}", trim(format!("{mantissa:.5}")))
+        f64::next_up
     };
-    match s.parse::<f64>() {
-        Ok(v) if inside(v) => s,
-        _ => given(bound),
+    let mut v = bound;
+    for _ in 0..64 {
+        if inside(v) {
+            return given(v);
+        }
+        v = step(v);
+    }
+    given(bound)
+}
+
+/// A computed number compared in a message with `other`: [`short`], unless that would
+/// read the same as `other` as written ([`given`]) or rounded ([`short`]); then exactly.
+fn apart(x: f64, other: f64) -> String {
+    let s = short(x);
+    if s == given(other) || s == short(other) {
+        given(x)
+    } else {
+        s
     }
 }
 
@@ -478,7 +514,7 @@ impl WorldSpec {
                 format!(
                     "is {} m, more than the arena's diagonal ({} m): every pair of agents would be in contact all the time",
                     given(detection_radius),
-                    given(diagonal)
+                    apart(diagonal, detection_radius)
                 ),
                 "use a detection radius well below the arena's size (the paper's r_d is 0.01 m)",
             ));
@@ -632,13 +668,19 @@ impl WorldSpec {
         let sweep_end = |field: &str, v: Option<f64>, default: f64| {
             let x = ctx.finite(field, v.unwrap_or(default), "give an x in metres")?;
             if x < xlo - tol || x > xhi + tol {
+                // Rounded unless that makes the two ends, or an end and x, read the same.
+                let range = if short(xlo) == short(xhi) {
+                    (given(xlo), given(xhi))
+                } else {
+                    (apart(xlo, x), apart(xhi, x))
+                };
                 return Err(ctx.err(
                     field,
-                    format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), given(xlo), given(xhi)),
+                    format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), range.0, range.1),
                     format!(
                         "use an x between {} and {}, or leave it out for the default",
-                        suggest(xlo, f64::ceil, |v| v >= xlo - tol),
-                        suggest(xhi, f64::floor, |v| v <= xhi + tol)
+                        suggest(xlo, f64::ceil, |v| v >= xlo - tol && v <= xhi + tol),
+                        suggest(xhi, f64::floor, |v| v >= xlo - tol && v <= xhi + tol)
                     ),
                 ));
             }
@@ -670,7 +712,7 @@ impl WorldSpec {
                     "is {} s: two agents walking at {} m/s towards each other close {} m per step, more than the detection radius {} m, so encounters could be stepped over unseen",
                     given(dt),
                     given(speed),
-                    given(2.0 * speed * dt),
+                    apart(2.0 * speed * dt, detection_radius),
                     given(detection_radius)
                 ),
                 format!(
@@ -771,28 +813,50 @@ impl WorldSpec {
             seed: self.seed.unwrap_or(1),
         };
 
-        // Durations.
+        // Durations. (start_x and end_x are the clamped or default ends: computed, so
+        // written short.)
         if !world.sweep_duration().is_finite() {
             return Err(ctx.err(
                 "leader.speed",
                 format!(
                     "is {} m/s, so the sweep from x = {} to {} m would never end",
                     given(world.leader.speed),
-                    given(start_x),
-                    given(end_x)
+                    short(start_x),
+                    short(end_x)
                 ),
                 "give the leader a speed such as the paper's 0.005 m/s",
             ));
         }
         let total = world.total_duration();
-        if total.is_nan() || total <= 0.0 || !total.is_finite() {
+        if total.is_infinite() {
+            // Each part is finite, their sum is not: blame the larger.
+            let (field, value) = if dispersion_time >= world.sweep_duration() {
+                (
+                    "simulation.dispersion_time",
+                    format!("{} s", given(dispersion_time)),
+                )
+            } else {
+                ("leader.speed", format!("{} m/s", given(world.leader.speed)))
+            };
+            return Err(ctx.err(
+                field,
+                format!(
+                    "is {value}, so the run (dispersion {} s plus a sweep of {} s) would last \
+                     longer than any time a number can hold",
+                    given(dispersion_time),
+                    short(world.sweep_duration())
+                ),
+                "shorten the dispersion or speed up the leader",
+            ));
+        }
+        if total.is_nan() || total <= 0.0 {
             return Err(ctx.err(
                 "leader.end_x",
                 format!(
                     "is {} m and the run lasts {total} s (dispersion {} s plus the sweep from x = {} m)",
-                    given(end_x),
+                    short(end_x),
                     given(dispersion_time),
-                    given(start_x)
+                    short(start_x)
                 ),
                 "give the sweep a positive length (end_x ≠ start_x) or a positive simulation.dispersion_time",
             ));
@@ -825,7 +889,7 @@ impl WorldSpec {
                 ),
                 format!(
                     "use an overlap Δt below {} s, or fewer windows",
-                    short(window_duration)
+                    suggest(window_duration, f64::floor, |v| v <= window_duration)
                 ),
             ));
         }
@@ -848,14 +912,14 @@ fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
             if free <= 0.0 {
                 return Err(ctx.err(
                     "swarm.placement",
-                    format!("is a disc of radius {} m around ({}, {}) with no free space for an agent of body radius {} m", given(radius), given(xs), given(h / 2.0), given(body)),
+                    format!("is a disc of radius {} m around ({}, {}) with no free space for an agent of body radius {} m", given(radius), given(xs), short(h / 2.0), given(body)),
                     "enlarge the disc, use `Window`, or move leader.start_x or the obstacles",
                 ));
             }
             if free < need {
                 return Err(ctx.err(
                     "swarm.placement",
-                    format!("is a disc of radius {} m around ({}, {}) with only {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {} m need", given(radius), given(xs), given(h / 2.0), world.swarm.agents, given(body)),
+                    format!("is a disc of radius {} m around ({}, {}) with only {free:.4} m² of free space, less than the {need:.4} m² that {} agents of body radius {} m need", given(radius), given(xs), short(h / 2.0), world.swarm.agents, given(body)),
                     "enlarge the disc, use `Window`, or use fewer agents",
                 ));
             }
@@ -963,8 +1027,9 @@ mod tests {
         assert_eq!(given(0.1), "0.1");
         assert_eq!(given(1.0 / 3.0), "0.3333333333333333");
         assert_eq!(given(30.000000001), "30.000000001");
-        assert_eq!(given(123456789012345.0), "123456789012345");
-        assert_eq!(given(1e15), "1e15");
+        assert_eq!(given(123456789.0), "123456789");
+        assert_eq!(given(1e9), "1e9");
+        assert_eq!(given(1234567890.5), "1.2345678905e9");
         assert_eq!(given(1e300), "1e300");
         assert_eq!(given(-2.5e39), "-2.5e39");
         assert_eq!(given(1.234567e-9), "1.234567e-9");
@@ -996,6 +1061,18 @@ mod tests {
                 <= r_d * (1.0 + 1e-9)),
             "0.05"
         );
+        // Next to a power of ten the rounded mantissa moves to the next exponent.
+        assert_eq!(at_least(9.999991e-7), "1e-6");
+        assert_eq!(at_most(9.999999999999997e-7), "9.99999e-7");
+        assert_eq!(at_least(0.0009999995), "0.001");
+        assert_eq!(at_most(0.0009999995), "0.000999999");
+        // A subnormal bound is written exactly, or stepped inward until it is accepted.
+        let tiny = 5.17e-321;
+        assert!(at_most(tiny).parse::<f64>().unwrap() <= tiny);
+        assert_eq!(
+            suggest(tiny, f64::floor, |v| v < tiny),
+            given(tiny.next_down())
+        );
         for x in [
             1.0 / 3.0,
             2.0 / 7.0,
@@ -1011,6 +1088,14 @@ mod tests {
             assert!(at_most(x).parse::<f64>().unwrap() <= x, "{x}");
             assert!(at_least(x).parse::<f64>().unwrap() >= x, "{x}");
         }
+    }
+
+    #[test]
+    fn apart_rounds_unless_the_two_would_read_the_same() {
+        assert_eq!(apart(41.23105625617661, 45.0), "41.2311");
+        assert_eq!(apart(0.6000000000000001, 0.1), "0.6");
+        assert_eq!(apart(0.0100000002, 0.01), "0.0100000002");
+        assert_eq!(apart(10000.0000001, 10000.0), "10000.0000001");
     }
 
     #[test]

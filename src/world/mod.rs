@@ -19,7 +19,7 @@ mod spec;
 mod summary;
 mod types;
 
-pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, given, landmark_count, short};
+pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, given, landmark_count, short, suggest};
 pub use distance_index::{MIN_INDEXED_VERTICES, ObstacleDistances};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;

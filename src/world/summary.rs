@@ -1,7 +1,7 @@
 //! Loading a world from a file, the time windows of the mapping (paper §"Dynamic
 //! Topological Mapping", eq. for W_i), and the short summary `swarmmap check` prints.
 
-use super::check::{given, landmark_count};
+use super::check::{given, landmark_count, short};
 use super::error::WorldError;
 use super::freespace::FreeSpaceRaster;
 use super::spec::{WorldSpec, parse_str};
@@ -123,7 +123,7 @@ impl World {
             "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in {}",
             sw.agents,
             landmarks,
-            given(100.0 * sw.landmark_fraction),
+            short(100.0 * sw.landmark_fraction),
             given(sw.detection_radius),
             given(sw.speed),
             given(sw.body_radius),
