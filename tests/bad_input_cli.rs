@@ -86,6 +86,25 @@ fn huge_and_tiny_values_are_written_with_an_exponent_in_messages() {
     }
 }
 
+/// `swarmmap check WORLD --set ...` with every set in `sets`.
+fn check_with(world: &str, sets: &[&str]) -> std::process::Output {
+    let mut c = swarmmap();
+    c.args(["check", world]);
+    for s in sets {
+        c.args(["--set", s]);
+    }
+    c.output().unwrap()
+}
+
+/// The text of `stderr` between `before` and the first `until` after it.
+fn between<'t>(stderr: &'t str, before: &str, until: &str) -> &'t str {
+    stderr
+        .split(before)
+        .nth(1)
+        .and_then(|rest| rest.split(until).next())
+        .unwrap_or_else(|| panic!("no {before:?} in: {stderr}"))
+}
+
 /// The largest time step the encounter check suggests is one it accepts: rounded down, not
 /// to the nearest (0.0166667 s would still be refused for r_d = 1 cm at 0.3 m/s).
 #[test]
@@ -95,24 +114,14 @@ fn the_suggested_time_step_passes_the_check() {
         "swarm.body_radius=0.004",
         "swarm.speed=0.3",
     ];
-    let check = |dt: &str| {
-        let mut c = swarmmap();
-        c.args(["check", TINY]);
-        for s in sets {
-            c.args(["--set", s]);
-        }
-        c.args(["--set", &format!("simulation.dt={dt}")]);
-        c.assert()
-    };
-    let refused = check("0.03").code(2);
-    let text = String::from_utf8(refused.get_output().stderr.clone()).unwrap();
-    let suggested = text
-        .split("set simulation.dt ≤ r_d / (2·speed) = ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .unwrap_or_else(|| panic!("no suggested time step in: {text}"));
+    let refused = check_with(TINY, &[&sets[..], &["simulation.dt=0.03"]].concat());
+    assert_eq!(refused.status.code(), Some(2));
+    let text = String::from_utf8(refused.stderr).unwrap();
+    let suggested = between(&text, "set simulation.dt ≤ r_d / (2·speed) = ", " ");
     assert_eq!(suggested, "0.0166666");
-    check(suggested).success();
+    let dt = format!("simulation.dt={suggested}");
+    let accepted = check_with(TINY, &[&sets[..], &[dt.as_str()]].concat());
+    assert!(accepted.status.success(), "{dt} refused");
 }
 
 /// Every bound a message proposes is one the check accepts: both ends of the leader's range
@@ -125,60 +134,30 @@ fn suggested_ranges_and_overlaps_pass_the_check() {
         "arena.width=7.777777",
         "leader.window=7.777776",
     ];
-    let check = |sets: &[&str], last: String| {
-        let mut c = swarmmap();
-        c.args(["check", TINY]);
-        for s in sets {
-            c.args(["--set", s]);
-        }
-        c.args(["--set", &last]);
-        c.output().unwrap()
-    };
-    let out = check(&narrow, "leader.start_x=0".into());
+    let out = check_with(TINY, &[&narrow[..], &["leader.start_x=0"]].concat());
     let text = String::from_utf8(out.stderr).unwrap();
-    let range = text
-        .split("use an x between ")
-        .nth(1)
-        .and_then(|r| r.split(", or leave").next())
-        .unwrap_or_else(|| panic!("no range in: {text}"));
+    let range = between(&text, "use an x between ", ", or leave");
     let (lo, hi) = range.split_once(" and ").unwrap();
     assert!(
         lo.parse::<f64>().unwrap() <= hi.parse::<f64>().unwrap(),
         "{range}"
     );
     for x in [lo, hi] {
-        let o = check(&narrow, format!("leader.start_x={x}"));
+        let start = format!("leader.start_x={x}");
+        let o = check_with(TINY, &[&narrow[..], &[start.as_str()]].concat());
         let e = String::from_utf8(o.stderr).unwrap();
         assert!(!e.contains("leader.start_x is"), "{x} refused: {e}");
     }
 
     let seven = ["mapping.windows=7", "simulation.dispersion_time=300"];
-    let mut c = swarmmap();
-    c.args(["check", "worlds/scenario2.ron"]);
-    for s in seven {
-        c.args(["--set", s]);
-    }
-    let text = String::from_utf8(
-        c.args(["--set", "mapping.overlap=900"])
-            .output()
-            .unwrap()
-            .stderr,
-    )
-    .unwrap();
-    let below = text
-        .split("use an overlap Δt below ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .unwrap_or_else(|| panic!("no overlap bound in: {text}"));
+    let scenario2 = "worlds/scenario2.ron";
+    let out = check_with(scenario2, &[&seven[..], &["mapping.overlap=900"]].concat());
+    let text = String::from_utf8(out.stderr).unwrap();
+    let below = between(&text, "use an overlap Δt below ", " ");
     assert_eq!(below, "814.285");
-    let mut c = swarmmap();
-    c.args(["check", "worlds/scenario2.ron"]);
-    for s in seven {
-        c.args(["--set", s]);
-    }
-    c.args(["--set", &format!("mapping.overlap={below}")])
-        .assert()
-        .success();
+    let overlap = format!("mapping.overlap={below}");
+    let accepted = check_with(scenario2, &[&seven[..], &[overlap.as_str()]].concat());
+    assert!(accepted.status.success(), "{overlap} refused");
 }
 
 #[test]
