@@ -309,8 +309,9 @@ pub fn given(x: f64) -> String {
 /// A bound to suggest in a message, as short as the check lets it be: [`short`] (rounded
 /// to nearest) where the check `accepts` that value, else rounded toward the inside to 6
 /// significant digits (`round` is `f64::floor` for an upper bound, `f64::ceil` for a lower
-/// one) where it accepts that, else exactly ([`given`]). Either way a user who copies the
-/// number gets a value the check accepts.
+/// one) where it accepts that, else exactly ([`given`]) the bound or, where even that is
+/// refused, the nearest value inward that is not. Either way a user who copies the number
+/// gets a value the check accepts.
 pub fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> String {
     let nearest = short(bound);
     if nearest.parse::<f64>().is_ok_and(&accepts) {
