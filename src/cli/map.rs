@@ -164,7 +164,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             short(length),
             short(cfg.span.1 - cfg.span.0),
             cfg.windows,
-            swarmmap::world::suggest(length, f64::floor, |v| v <= length),
+            swarmmap::world::suggest(length, swarmmap::world::Inward::Down, |v| v <= length),
         )));
     }
     if let Some(method) = args.method {

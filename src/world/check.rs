@@ -306,29 +306,54 @@ pub fn given(x: f64) -> String {
     }
 }
 
+/// Which way from a bound the values a check accepts lie: below an upper bound (`Down`),
+/// above a lower one (`Up`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Inward {
+    Down,
+    Up,
+}
+
+impl Inward {
+    fn round(self, x: f64) -> f64 {
+        match self {
+            Inward::Down => x.floor(),
+            Inward::Up => x.ceil(),
+        }
+    }
+
+    fn step(self, x: f64) -> f64 {
+        match self {
+            Inward::Down => x.next_down(),
+            Inward::Up => x.next_up(),
+        }
+    }
+}
+
 /// A bound to suggest in a message, as short as the check lets it be: [`short`] (rounded
-/// to nearest) where the check `accepts` that value, else rounded toward the inside to 6
-/// significant digits (`round` is `f64::floor` for an upper bound, `f64::ceil` for a lower
-/// one) where it accepts that, else exactly ([`given`]) the bound or, where even that is
-/// refused, the nearest value inward that is not. Either way a user who copies the number
-/// gets a value the check accepts.
-pub fn suggest(bound: f64, round: fn(f64) -> f64, accepts: impl Fn(f64) -> bool) -> String {
+/// to nearest) where the check `accepts` that value, else rounded `inward` to 6
+/// significant digits where it accepts that, else exactly ([`given`]) the bound or, where
+/// even that is refused, the nearest value inward that is not. Either way a user who copies
+/// the number gets a value the check accepts.
+pub fn suggest(bound: f64, inward: Inward, accepts: impl Fn(f64) -> bool) -> String {
     let nearest = short(bound);
     if nearest.parse::<f64>().is_ok_and(&accepts) {
         return nearest;
     }
-    rounded_within(bound, round, accepts)
+    rounded_within(bound, inward, accepts)
 }
 
-fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> bool) -> String {
+/// A decimal number's text without trailing zeros after its point (nor a bare point).
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
+}
+
+fn rounded_within(bound: f64, inward: Inward, inside: impl Fn(f64) -> bool) -> String {
     if bound.is_normal() {
-        let trim = |s: String| {
-            if s.contains('.') {
-                s.trim_end_matches('0').trim_end_matches('.').to_string()
-            } else {
-                s
-            }
-        };
         // The decimal exponent as Rust writes it (`{:e}`), not `log10().floor()`, which
         // can be one off next to a power of ten.
         let sci = format!("{bound:e}");
@@ -339,21 +364,22 @@ fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> boo
         let s = if (1e-6..1e9).contains(&bound.abs()) {
             let digits = (5 - e).max(0);
             let scale = 10f64.powi(digits);
-            trim(format!(
+            let text = format!(
                 "{:.*}",
                 digits as usize,
-                round(bound * scale) / scale
-            ))
+                inward.round(bound * scale) / scale
+            );
+            trim_zeros(&text).to_string()
         } else {
             // Mantissa and exponent, as `short` writes them; a mantissa rounded up to 10
             // moves to the next exponent.
-            let rounded = round(mantissa * 1e5) / 1e5;
+            let rounded = inward.round(mantissa * 1e5) / 1e5;
             let (m, e) = if rounded.abs() >= 10.0 {
                 (rounded / 10.0, e + 1)
             } else {
                 (rounded, e)
             };
-            format!("{}e{e}", trim(format!("{m:.5}")))
+            format!("{}e{e}", trim_zeros(&format!("{m:.5}")))
         };
         if s.parse::<f64>().is_ok_and(&inside) {
             return s;
@@ -361,17 +387,12 @@ fn rounded_within(bound: f64, round: fn(f64) -> f64, inside: impl Fn(f64) -> boo
     }
     // Exactly, or the nearest value inward that the check accepts (a bound computed in
     // floating point, a subnormal one above all, may itself fall just outside).
-    let step: fn(f64) -> f64 = if round(0.5) == 0.0 {
-        f64::next_down
-    } else {
-        f64::next_up
-    };
     let mut v = bound;
     for _ in 0..64 {
         if inside(v) {
             return given(v);
         }
-        v = step(v);
+        v = inward.step(v);
     }
     given(bound)
 }
@@ -398,16 +419,10 @@ pub fn short(x: f64) -> String {
         // of digits.
         let s = format!("{x:.5e}");
         let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = m.trim_end_matches('0').trim_end_matches('.');
-        return format!("{m}e{e}");
+        return format!("{}e{e}", trim_zeros(m));
     }
     let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
+    trim_zeros(&format!("{x:.digits$}")).to_string()
 }
 
 fn bbox(points: &[Vec2]) -> (Vec2, Vec2) {
@@ -680,8 +695,8 @@ impl WorldSpec {
                     format!("is {} m, outside [window/2, width − window/2] = [{}, {}] m, so D(t) would stick out of the arena", given(x), range.0, range.1),
                     format!(
                         "use an x between {} and {}, or leave it out for the default",
-                        suggest(xlo, f64::ceil, |v| v >= xlo - tol && v <= xhi + tol),
-                        suggest(xhi, f64::floor, |v| v >= xlo - tol && v <= xhi + tol)
+                        suggest(xlo, Inward::Up, |v| v >= xlo - tol && v <= xhi + tol),
+                        suggest(xhi, Inward::Down, |v| v >= xlo - tol && v <= xhi + tol)
                     ),
                 ));
             }
@@ -718,7 +733,7 @@ impl WorldSpec {
                 ),
                 format!(
                     "set simulation.dt ≤ r_d / (2·speed) = {} s (a world that sets no dt gets the default), or lower swarm.speed, or raise swarm.detection_radius",
-                    suggest(detection_radius / (2.0 * speed), f64::floor, |v| {
+                    suggest(detection_radius / (2.0 * speed), Inward::Down, |v| {
                         2.0 * speed * v <= detection_radius * (1.0 + 1e-9)
                     })
                 ),
@@ -890,7 +905,7 @@ impl WorldSpec {
                 ),
                 format!(
                     "use an overlap Δt below {} s, or fewer windows",
-                    suggest(window_duration, f64::floor, |v| v <= window_duration)
+                    suggest(window_duration, Inward::Down, |v| v <= window_duration)
                 ),
             ));
         }
@@ -1042,8 +1057,8 @@ mod tests {
 
     #[test]
     fn bounds_are_rounded_towards_the_side_the_check_accepts() {
-        let at_most = |x: f64| suggest(x, f64::floor, |v| v <= x);
-        let at_least = |x: f64| suggest(x, f64::ceil, |v| v >= x);
+        let at_most = |x: f64| suggest(x, Inward::Down, |v| v <= x);
+        let at_least = |x: f64| suggest(x, Inward::Up, |v| v >= x);
         assert_eq!(at_most(0.01 / (2.0 * 0.3)), "0.0166666");
         assert_eq!(at_least(0.01 / (2.0 * 0.3)), "0.0166667");
         assert_eq!(at_most(28.5), "28.5");
@@ -1058,7 +1073,7 @@ mod tests {
         // f64, and the time-step check accepts 0.05 within its tolerance.
         let (r_d, v) = (0.01, 0.1);
         assert_eq!(
-            suggest(r_d / (2.0 * v), f64::floor, |x| 2.0 * v * x
+            suggest(r_d / (2.0 * v), Inward::Down, |x| 2.0 * v * x
                 <= r_d * (1.0 + 1e-9)),
             "0.05"
         );
@@ -1071,7 +1086,7 @@ mod tests {
         let tiny = 5.17e-321;
         assert!(at_most(tiny).parse::<f64>().unwrap() <= tiny);
         assert_eq!(
-            suggest(tiny, f64::floor, |v| v < tiny),
+            suggest(tiny, Inward::Down, |v| v < tiny),
             given(tiny.next_down())
         );
         for x in [

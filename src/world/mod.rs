@@ -19,7 +19,9 @@ mod spec;
 mod summary;
 mod types;
 
-pub use check::{MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, given, landmark_count, short, suggest};
+pub use check::{
+    Inward, MAX_AGENTS, MAX_STEPS, MAX_WINDOWS, given, landmark_count, short, suggest,
+};
 pub use distance_index::{MIN_INDEXED_VERTICES, ObstacleDistances};
 pub use error::WorldError;
 pub use freespace::FreeSpaceRaster;
