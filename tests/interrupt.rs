@@ -216,3 +216,40 @@ fn interrupting_a_run_over_an_earlier_one_never_mixes_the_two() {
         "no interrupt came after the new run began writing"
     );
 }
+
+#[test]
+fn sigterm_and_sighup_are_handled_like_ctrl_c() {
+    // Found by the fortieth session's review: only SIGINT was caught (the `termination`
+    // feature of `ctrlc` was off), so SIGTERM and SIGHUP killed the process outright, with
+    // status 143 or 129, no message and any temporary file left behind.
+    let tmp = tempfile::tempdir().unwrap();
+    for signal in ["TERM", "HUP"] {
+        let out = tmp.path().join(signal);
+        // A run that takes seconds: the signal lands after start-up, mid-simulation.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_swarmmap"))
+            .args(["simulate", "worlds/scenario2.ron", "--quiet", "--out"])
+            .arg(&out)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(800));
+        let _ = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status();
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(
+            (output.status.code(), output.status.signal()),
+            (Some(130), None),
+            "SIG{signal}: {stderr}"
+        );
+        assert!(stderr.contains("interrupted"), "SIG{signal}: {stderr}");
+        for rel in files(&out).keys() {
+            assert!(
+                !rel.to_string_lossy().ends_with(".tmp"),
+                "SIG{signal}: {rel:?} left behind"
+            );
+        }
+    }
+}
