@@ -75,9 +75,10 @@ pub struct CalibrateArgs {
     /// windows. Repeat the option for both. The model written is still the fit on all.
     #[arg(long = "cross-validate", value_enum, value_name = "GROUPS")]
     pub cross_validate: Vec<CvGroups>,
-    /// Also write the H1 grid the fit searches to this CSV, one row per (h1_ratio, h1_span)
-    /// with the training windows it gets right and its false-hole share, to see how flat
-    /// the optimum is and which other rules score nearly as well.
+    /// Also write the H1 grid the fit searches to this CSV, one row per grid point
+    /// (h1_ratio, h1_span, and h1_crossing / h1_stability when --crossing / --stability
+    /// search them) with the training windows it gets right and its false-hole share, to
+    /// see how flat the optimum is and which other rules score nearly as well.
     #[arg(long, value_name = "CSV")]
     pub landscape: Option<PathBuf>,
     /// Keep each finished training run's diagrams in DIR (one JSON file per world, `--set`
