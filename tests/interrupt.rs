@@ -226,7 +226,7 @@ fn sigterm_and_sighup_are_handled_like_ctrl_c() {
     for signal in ["TERM", "HUP"] {
         let out = tmp.path().join(signal);
         // A run that takes seconds: the signal lands after start-up, mid-simulation.
-        let mut child = Command::new(env!("CARGO_BIN_EXE_swarmmap"))
+        let child = Command::new(env!("CARGO_BIN_EXE_swarmmap"))
             .args(["simulate", "worlds/scenario2.ron", "--quiet", "--out"])
             .arg(&out)
             .stdout(Stdio::null())

@@ -456,6 +456,16 @@ fn a_model_file_replaces_the_shipped_thresholds() {
     for (file, says) in [
         (&broken, "broken.json:2:"),
         (&out_of_range, "out of range"),
+        // The place of the model out of range (found by the fortieth session's review: the
+        // message named only the file), and the place given once, not again at its end.
+        (
+            &out_of_range,
+            "range.json:9:3: the Embedded model's thresholds (h0_ratio",
+        ),
+        (
+            &broken,
+            "expected a model object or a list of model objects; a model file",
+        ),
         (&missing, "cannot read the model file"),
     ] {
         map_with(&dir, file).code(2).stderr(contains(says));

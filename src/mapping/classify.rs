@@ -54,15 +54,27 @@ pub struct Classifier {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Models {
-    #[serde(rename = "Paper")]
+    #[serde(rename = "Paper", deserialize_with = "paper_bank")]
     pub paper: Bank,
-    #[serde(rename = "Embedded")]
+    #[serde(rename = "Embedded", deserialize_with = "embedded_bank")]
     pub embedded: Bank,
     /// The truth-position oracle's models ([`crate::mapping::output::Fidelity::oracle`]):
     /// fitted on the same stage run on true positions, whose diagrams are far less noisy
     /// than those of estimated clouds (`swarmmap calibrate --oracle`).
-    #[serde(rename = "Oracle")]
+    #[serde(rename = "Oracle", deserialize_with = "oracle_bank")]
     pub oracle: Bank,
+}
+
+fn paper_bank<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Bank, D::Error> {
+    Bank::deserialize_named(d, "Paper")
+}
+
+fn embedded_bank<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Bank, D::Error> {
+    Bank::deserialize_named(d, "Embedded")
+}
+
+fn oracle_bank<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Bank, D::Error> {
+    Bank::deserialize_named(d, "Oracle")
 }
 
 /// A fitted classifier and its provenance.
@@ -160,26 +172,167 @@ impl Serialize for Bank {
 }
 
 impl<'de> Deserialize<'de> for Bank {
-    /// Reads the object or the array as it streams (not through an untagged enum, which
-    /// buffers the value and loses the position and the reason of a fault inside it).
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct BankVisitor;
+        Bank::deserialize_named(d, "bank")
+    }
+}
+
+impl Bank {
+    /// Reads the object or the array as it streams (not through an untagged enum, which
+    /// buffers the value and loses the position and the reason of a fault inside it), and
+    /// checks each model as soon as it is read ([`check_model`]) and the bank at its end
+    /// ([`check_bank`]), so that a JSON reader reports the place of a model out of range:
+    /// just after it. `name` is the bank's entry, for the messages.
+    fn deserialize_named<'de, D: serde::Deserializer<'de>>(
+        d: D,
+        name: &'static str,
+    ) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        struct BankVisitor(&'static str);
         impl<'de> serde::de::Visitor<'de> for BankVisitor {
             type Value = Bank;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("a model object or a list of model objects")
             }
             fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Bank, A::Error> {
-                let one = Model::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
-                Ok(Bank(vec![one]))
+                Ok(Bank(vec![CheckedModel(self.0).visit_map(map)?]))
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Bank, A::Error> {
-                Vec::<Model>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
-                    .map(Bank)
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Bank, A::Error> {
+                let mut models = Vec::new();
+                // Checked inside the element's own map visit, so that the reader places
+                // a fault just after that model, not after the list's next token.
+                while let Some(m) = seq.next_element_seed(CheckedModel(self.0))? {
+                    models.push(m);
+                }
+                let bank = Bank(models);
+                check_bank(self.0, &bank).map_err(A::Error::custom)?;
+                Ok(bank)
             }
         }
-        d.deserialize_any(BankVisitor)
+        d.deserialize_any(BankVisitor(name))
     }
+}
+
+/// One model of a bank's list, checked by [`check_model`] as soon as its object is read.
+struct CheckedModel(&'static str);
+
+impl<'de> serde::de::DeserializeSeed<'de> for CheckedModel {
+    type Value = Model;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Model, D::Error> {
+        d.deserialize_map(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for CheckedModel {
+    type Value = Model;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a model object")
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Model, A::Error> {
+        use serde::de::Error;
+        let m = Model::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+        check_model(self.0, &m).map_err(A::Error::custom)?;
+        Ok(m)
+    }
+}
+
+/// Starts every message of [`check_model`] and [`check_bank`]: the entry's name, so that
+/// [`Models::load`] tells a value out of range (whose message says how to fix it) from a
+/// file that is not a model file at all.
+fn entry_says(name: &str) -> String {
+    format!("the {name} ")
+}
+
+/// A bank must hold a model, and the models of one sweep must all carry their densities.
+fn check_bank(name: &str, bank: &Bank) -> Result<(), String> {
+    let the = entry_says(name);
+    if bank.0.is_empty() {
+        return Err(format!(
+            "{the}entry is an empty list; give at least one model"
+        ));
+    }
+    for m in &bank.0 {
+        let same = bank.for_sweep(m.sweep());
+        if same.0.len() > 1 && same.0.iter().any(|m| m.events_per_point.is_none()) {
+            return Err(format!(
+                "{the}entry lists {} models fitted at the sweep of {} m/s but not every one \
+                 has \"events_per_point\" ({{\"min\", \"median\", \"max\"}}), which picks \
+                 the model of each window among them; models of one sweep need it on every \
+                 one (calibrate writes it)",
+                same.0.len(),
+                m.sweep()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A model's thresholds, sweep and densities must lie in their ranges.
+fn check_model(name: &str, m: &Model) -> Result<(), String> {
+    let the = entry_says(name);
+    let c = m.classifier;
+    let ok = c.h0_ratio > 0.0
+        && c.h0_ratio <= MAX_THRESHOLD
+        && c.h1_ratio >= 1.0
+        && c.h1_ratio <= MAX_THRESHOLD
+        && c.h1_span >= 0.0
+        && c.h1_span <= MAX_THRESHOLD;
+    if !ok {
+        return Err(format!(
+            "{the}model's thresholds (h0_ratio {}, h1_ratio {}, h1_span {}) are out of \
+             range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, all at most 1e12 \
+             (fitted models stay below 100)",
+            crate::world::given(c.h0_ratio),
+            crate::world::given(c.h1_ratio),
+            crate::world::given(c.h1_span)
+        ));
+    }
+    if let Some(x) = c.h1_crossing
+        && !(0.0..=1.0).contains(&x)
+    {
+        return Err(format!(
+            "{the}model's h1_crossing is {}; it is the largest share of time lines that may \
+             cross a hole, from 0 to 1 (or leave it out for no crossing test)",
+            crate::world::given(x)
+        ));
+    }
+    if let Some(x) = c.h1_stability
+        && !(0.0..=MAX_THRESHOLD).contains(&x)
+    {
+        return Err(format!(
+            "{the}model's h1_stability is {}; it is the least life, in σ, that both halves \
+             of a window must give a hole, a number from 0 to 1e12 (or leave it out for no \
+             stability test)",
+            crate::world::given(x)
+        ));
+    }
+    if let Some(v) = m.leader_speed
+        && !(v.is_finite() && v > 0.0)
+    {
+        return Err(format!(
+            "{the}model's leader_speed is {}; it is the sweep speed of its training runs in \
+             m/s, positive and finite (or leave it out for the default sweep, \
+             {DEFAULT_SWEEP} m/s)",
+            crate::world::given(v)
+        ));
+    }
+    if let Some(d) = m.events_per_point {
+        let ok = [d.min, d.median, d.max]
+            .iter()
+            .all(|x| x.is_finite() && *x > 0.0)
+            && d.min <= d.median
+            && d.median <= d.max;
+        if !ok {
+            return Err(format!(
+                "{the}model's events_per_point ({}, {}, {}) must be positive and finite with \
+                 min ≤ median ≤ max",
+                crate::world::given(d.min),
+                crate::world::given(d.median),
+                crate::world::given(d.max)
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl Bank {
@@ -312,111 +465,30 @@ impl Models {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read the model file {}", path.display()))?;
         let models: Models = serde_json::from_str(&text).map_err(|e| {
-            anyhow::anyhow!(
-                "{}:{}:{}: not a model file: {e}; a model file is what `swarmmap calibrate \
-                 --out FILE` writes: an object with \"Paper\", \"Embedded\" and \"Oracle\" \
-                 entries, each a model {{\"classifier\": {{\"h0_ratio\", \"h1_ratio\", \
-                 \"h1_span\"}}, \"fitted_on\"}} or a list of models that also carry \
-                 \"events_per_point\": {{\"min\", \"median\", \"max\"}}, and may carry \
-                 \"leader_speed\" (m/s, the sweep they were fitted at; see assets/classifier.json)",
-                path.display(),
-                e.line(),
-                e.column()
-            )
+            // serde_json's message ends with the place, which goes in front instead.
+            let message = e.to_string();
+            let message = message
+                .strip_suffix(&format!(" at line {} column {}", e.line(), e.column()))
+                .unwrap_or(&message);
+            let at = format!("{}:{}:{}", path.display(), e.line(), e.column());
+            if ["Paper", "Embedded", "Oracle"]
+                .iter()
+                .any(|name| message.starts_with(&entry_says(name)))
+            {
+                // A value out of range: the message says what each value must be.
+                anyhow::anyhow!("{at}: {message}")
+            } else {
+                anyhow::anyhow!(
+                    "{at}: not a model file: {message}; a model file is what `swarmmap \
+                     calibrate --out FILE` writes: an object with \"Paper\", \"Embedded\" and \
+                     \"Oracle\" entries, each a model {{\"classifier\": {{\"h0_ratio\", \
+                     \"h1_ratio\", \"h1_span\"}}, \"fitted_on\"}} or a list of models that also \
+                     carry \"events_per_point\": {{\"min\", \"median\", \"max\"}}, and may \
+                     carry \"leader_speed\" (m/s, the sweep they were fitted at; see \
+                     assets/classifier.json)"
+                )
+            }
         })?;
-        for (name, bank) in [
-            ("Paper", &models.paper),
-            ("Embedded", &models.embedded),
-            ("Oracle", &models.oracle),
-        ] {
-            if bank.0.is_empty() {
-                anyhow::bail!(
-                    "{}: the {name} entry is an empty list; give at least one model",
-                    path.display()
-                );
-            }
-            for m in &bank.0 {
-                let same = bank.for_sweep(m.sweep());
-                if same.0.len() > 1 && same.0.iter().any(|m| m.events_per_point.is_none()) {
-                    anyhow::bail!(
-                        "{}: the {name} entry lists {} models fitted at the sweep of {} m/s but \
-                         not every one has \"events_per_point\" ({{\"min\", \"median\", \
-                         \"max\"}}), which picks the model of each window among them; models \
-                         of one sweep need it on every one (calibrate writes it)",
-                        path.display(),
-                        same.0.len(),
-                        m.sweep()
-                    );
-                }
-            }
-            for m in &bank.0 {
-                let c = m.classifier;
-                let ok = c.h0_ratio > 0.0
-                    && c.h0_ratio <= MAX_THRESHOLD
-                    && c.h1_ratio >= 1.0
-                    && c.h1_ratio <= MAX_THRESHOLD
-                    && c.h1_span >= 0.0
-                    && c.h1_span <= MAX_THRESHOLD;
-                if !ok {
-                    anyhow::bail!(
-                        "{}: the {name} model's thresholds (h0_ratio {:?}, h1_ratio {:?}, h1_span {:?}) \
-                         are out of range; h0_ratio must be > 0, h1_ratio ≥ 1 and h1_span ≥ 0, \
-                         all at most 1e12 (fitted models stay below 100)",
-                        path.display(),
-                        c.h0_ratio,
-                        c.h1_ratio,
-                        c.h1_span
-                    );
-                }
-                if let Some(x) = c.h1_crossing
-                    && !(0.0..=1.0).contains(&x)
-                {
-                    anyhow::bail!(
-                        "{}: the {name} model's h1_crossing is {x}; it is the largest share of \
-                         time lines that may cross a hole, from 0 to 1 (or leave it out for no \
-                         crossing test)",
-                        path.display()
-                    );
-                }
-                if let Some(x) = c.h1_stability
-                    && !(0.0..=MAX_THRESHOLD).contains(&x)
-                {
-                    anyhow::bail!(
-                        "{}: the {name} model's h1_stability is {x:?}; it is the least life, in \
-                         σ, that both halves of a window must give a hole, a number from 0 to \
-                         1e12 (or leave it out for no stability test)",
-                        path.display()
-                    );
-                }
-                if let Some(v) = m.leader_speed
-                    && !(v.is_finite() && v > 0.0)
-                {
-                    anyhow::bail!(
-                        "{}: the {name} model's leader_speed is {v}; it is the sweep speed of \
-                         its training runs in m/s, positive and finite (or leave it out for the \
-                         default sweep, {DEFAULT_SWEEP} m/s)",
-                        path.display()
-                    );
-                }
-                if let Some(d) = m.events_per_point {
-                    let ok = [d.min, d.median, d.max]
-                        .iter()
-                        .all(|x| x.is_finite() && *x > 0.0)
-                        && d.min <= d.median
-                        && d.median <= d.max;
-                    if !ok {
-                        anyhow::bail!(
-                            "{}: the {name} model's events_per_point ({}, {}, {}) must be \
-                             positive and finite with min ≤ median ≤ max",
-                            path.display(),
-                            d.min,
-                            d.median,
-                            d.max
-                        );
-                    }
-                }
-            }
-        }
         Ok(models)
     }
 
@@ -943,5 +1015,43 @@ mod tests {
                 .contains("a model object or a list of model objects"),
             "{e}"
         );
+    }
+
+    /// A model out of range is reported just after it, in a list or alone, and the message
+    /// gives the place once (found by the fortieth session's review: it named only the file).
+    #[test]
+    fn a_model_out_of_range_is_reported_at_its_place() {
+        let model = |ratio: f64, median: f64| {
+            format!(
+                "{{\"classifier\": {{\"h0_ratio\": 1, \"h1_ratio\": {ratio}, \"h1_span\": 0}}, \
+                 \"fitted_on\": \"x\", \"events_per_point\": {{\"min\": 1, \"median\": {median}, \
+                 \"max\": 9}}}}"
+            )
+        };
+        let file = |second: f64, embedded: f64| {
+            format!(
+                "{{\n\"Paper\": [\n{},\n{}\n],\n\"Embedded\": {},\n\"Oracle\": {}\n}}",
+                model(2.0, 2.0),
+                model(second, 5.0),
+                model(embedded, 2.0),
+                model(2.0, 2.0)
+            )
+        };
+        // The second model of the Paper list (line 4) is out of range.
+        let err = load_text(&file(0.5, 2.0)).unwrap_err().to_string();
+        assert!(
+            err.contains(":4:")
+                && err.contains("the Paper model's thresholds (h0_ratio 1, h1_ratio 0.5"),
+            "{err}"
+        );
+        assert!(!err.contains("at line"), "{err}");
+        // The Embedded entry, a model alone (line 6), is out of range.
+        let err = load_text(&file(2.0, 0.25)).unwrap_err().to_string();
+        assert!(
+            err.contains(":6:") && err.contains("the Embedded model's"),
+            "{err}"
+        );
+        let text = file(2.0, 2.0);
+        assert!(load_text(&text).is_ok());
     }
 }
