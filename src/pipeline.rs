@@ -117,6 +117,15 @@ pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
 
 /// Reads the world a simulation ran with from its `meta.json`, if there is one.
 pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
+    match spec_from_run(dir)? {
+        Some(spec) => Ok(Some(spec.check()?)),
+        None => Ok(None),
+    }
+}
+
+/// The world spec a run's `meta.json` records, before its check (to take `--set`
+/// overrides first, as `swarmmap map --set` does); `None` without a `meta.json`.
+pub fn spec_from_run(dir: &Path) -> Result<Option<WorldSpec>, PipelineError> {
     let Some((path, value)) = read_meta(dir)? else {
         return Ok(None);
     };
@@ -138,7 +147,7 @@ pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
         ))
     })?;
     spec.origin.name = format!("{} (world)", path.display());
-    Ok(Some(spec.check()?))
+    Ok(Some(spec))
 }
 
 /// Maps a log: local maps of every window, connections, the global map, and (with the

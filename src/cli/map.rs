@@ -1,6 +1,6 @@
-//! `swarmmap map RUN_DIR [--windows N] [--overlap S]`: local maps, connections and the
-//! global map of an encounter log, from a simulation or a real experiment. An existing
-//! `RUN_DIR/report/` is regenerated from the new maps.
+//! `swarmmap map RUN_DIR [--windows N] [--overlap S] [--set mapping.FIELD=VALUE]`: local
+//! maps, connections and the global map of an encounter log, from a simulation or a real
+//! experiment. An existing `RUN_DIR/report/` is regenerated from the new maps.
 
 use super::{Failure, input, load_world};
 use clap::Args;
@@ -11,7 +11,7 @@ use swarmmap::mapping::local::LocalParams;
 use swarmmap::mapping::pipeline::MapConfig;
 use swarmmap::mapping::stitch::StitchParams;
 use swarmmap::pipeline::{
-    PipelineError, Timings, map_log, seed_from_run, world_from_run, write_maps,
+    PipelineError, Timings, map_log, seed_from_run, spec_from_run, write_maps,
 };
 use swarmmap::world::short;
 use swarmmap::world::{MappingMethod, MappingParams};
@@ -38,6 +38,12 @@ pub struct MapArgs {
     /// encounter point cloud, anchored on encounters with static landmarks).
     #[arg(long, value_enum)]
     pub method: Option<Method>,
+    /// Override a mapping parameter, `mapping.FIELD=VALUE` (repeatable; the whole section
+    /// as `mapping=(...)`), on top of the world's or, without a world, of the defaults: to
+    /// map a real log with the settings the shipped models were fitted at (the README's
+    /// "Commands" gives them). The windows are cut with --windows and --overlap instead.
+    #[arg(long = "set", value_name = "mapping.FIELD=VALUE")]
+    pub set: Vec<String>,
 }
 
 /// `--method` values.
@@ -56,11 +62,61 @@ impl From<Method> for MappingMethod {
     }
 }
 
+/// The mapping parameters `--set` gives on top of the defaults (for a log without a world),
+/// after refusing a `--set` that `map` cannot take: one outside `mapping`, the windows and
+/// the overlap (cut from the log with `--windows` and `--overlap`), and a field that a flag
+/// also gives.
+fn mapping_sets(args: &MapArgs) -> Result<MappingParams, Failure> {
+    for assignment in &args.set {
+        let path = assignment
+            .split_once('=')
+            .map_or(assignment.as_str(), |(p, _)| p);
+        let key = super::setting_key(path);
+        if key != "mapping" && !key.starts_with("mapping.") {
+            return Err(input(anyhow::anyhow!(
+                "--set {assignment}: map takes only mapping.FIELD=VALUE (or the whole \
+                 mapping=(...)); the log is already recorded, so the arena, the swarm, the \
+                 leader and the simulation are fixed by it (or by the world it is judged \
+                 against: --world)"
+            )));
+        }
+    }
+    let mut spec = swarmmap::world::WorldSpec::default();
+    spec.origin.name = "map".into();
+    super::apply_sets(&mut spec, &args.set)?;
+    let asked = spec.mapping.clone().unwrap_or_default();
+    for (given, flag, field) in [
+        (asked.windows.is_some(), "--windows", "mapping.windows"),
+        (asked.overlap.is_some(), "--overlap", "mapping.overlap"),
+    ] {
+        if given {
+            return Err(input(anyhow::anyhow!(
+                "--set gives {field}, but map cuts the log into windows with {flag} (checked \
+                 against the log's own span, not a world's run); pass {flag} instead"
+            )));
+        }
+    }
+    if asked.method.is_some() && args.method.is_some() {
+        return Err(input(anyhow::anyhow!(
+            "both --method and --set mapping.method are given, so one would be lost; give \
+             the method once"
+        )));
+    }
+    Ok(spec.check().map_err(input)?.mapping)
+}
+
 pub fn run(args: &MapArgs) -> Result<(), Failure> {
     let (log, notes) = EncounterLog::read_dir_noting(&args.run_dir).map_err(input)?;
+    let defaults = mapping_sets(args)?;
     let world = match &args.world {
-        Some(path) => Some(load_world(path, &[])?),
-        None => world_from_run(&args.run_dir).map_err(input)?,
+        Some(path) => Some(load_world(path, &args.set)?),
+        None => match spec_from_run(&args.run_dir).map_err(input)? {
+            Some(mut spec) => {
+                super::apply_sets(&mut spec, &args.set)?;
+                Some(spec.check().map_err(input)?)
+            }
+            None => None,
+        },
     };
     let (mut cfg, stitch) = match &world {
         Some(w) => (
@@ -71,7 +127,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             },
         ),
         None => {
-            let m = MappingParams::default();
+            let m = defaults.clone();
             let span = log.span().ok_or_else(|| {
                 input(anyhow::anyhow!(
                     "{}: the log has no encounters to map",
@@ -170,7 +226,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     if let Some(method) = args.method {
         let mut m = world
             .as_ref()
-            .map_or_else(MappingParams::default, |w| w.mapping.clone());
+            .map_or_else(|| defaults.clone(), |w| w.mapping.clone());
         m.method = method.into();
         let sweep = world
             .as_ref()
