@@ -115,6 +115,42 @@ pub fn seed_from_run(dir: &Path) -> Result<Option<u64>, PipelineError> {
     }
 }
 
+/// A warning when windows are far sparser than the training windows of the models that
+/// judge them ([`crate::mapping::classify::Bank::too_sparse_for`]): their holes are then
+/// likely noise. `None` when no window is.
+pub fn density_warning(maps: &[LocalMap], bank: &crate::mapping::classify::Bank) -> Option<String> {
+    let sparse: Vec<(&LocalMap, crate::mapping::classify::Density)> = maps
+        .iter()
+        .filter(|m| m.events_per_point.is_finite() && m.events_per_point > 0.0)
+        .filter_map(|m| bank.too_sparse_for(m.events_per_point).map(|d| (m, d)))
+        .collect();
+    let (_, d) = sparse.first()?;
+    let densities: Vec<f64> = sparse.iter().map(|(m, _)| m.events_per_point).collect();
+    let low = densities.iter().copied().fold(f64::INFINITY, f64::min);
+    let high = densities.iter().copied().fold(0.0, f64::max);
+    let mut names: Vec<String> = sparse.iter().map(|(m, _)| m.index.to_string()).collect();
+    let (which, verb, held) = match names.len() {
+        1 => (format!("window {}", names[0]), "holds", format!("{low:.2}")),
+        _ => {
+            let last = names.pop().unwrap_or_default();
+            (
+                format!("windows {} and {last}", names.join(", ")),
+                "hold",
+                format!("{low:.2}–{high:.2}"),
+            )
+        }
+    };
+    Some(format!(
+        "{which} {verb} {held} encounters per Rips vertex, far fewer than the {}–{} of the \
+         windows the classifier was fitted on: on such sparse clouds its thresholds show \
+         noise loops as holes; record more encounters per window (fewer --windows), sample \
+         the planar Rips complex with fewer points (--set mapping.rips_points=N), or fit a \
+         model at this density (swarmmap calibrate)",
+        crate::world::short(d.min),
+        crate::world::short(d.max),
+    ))
+}
+
 /// Reads the world a simulation ran with from its `meta.json`, if there is one.
 pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
     match spec_from_run(dir)? {

@@ -221,6 +221,43 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
     }
 }
 
+/// A window far sparser than the shipped model's training windows is warned about (found
+/// by the fortieth session's review: a tenth of a log's rows gave dozens of false holes in
+/// silence); at a density the model knows, nothing is said.
+#[test]
+fn map_warns_of_windows_far_sparser_than_the_models_training() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
+    let map = |extra: &[&str]| {
+        let out = swarmmap()
+            .args([
+                "map",
+                "--windows",
+                "2",
+                "--overlap",
+                "30",
+                "--method",
+                "embedded",
+            ])
+            .args(extra)
+            .arg(&log)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    // The tiny world's ≈ 180 encounters a window over as many Rips points: ≈ 1.4 a vertex.
+    let sparse = map(&[]);
+    assert!(
+        sparse.contains("encounters per Rips vertex, far fewer than the 4.39–12.08"),
+        "{sparse}"
+    );
+    assert!(sparse.contains("mapping.rips_points"), "{sparse}");
+    // 50 points: ≈ 3.6 a vertex, within the margin of the model's least (4.39 / 1.5).
+    let fine = map(&["--set", "mapping.rips_points=50"]);
+    assert!(!fine.contains("Rips vertex"), "{fine}");
+}
+
 /// `--method embedded` on a real log, with and without landmark intervals: every window
 /// keeps its component (the method falls back to all encounters where it has no landmark
 /// encounters to anchor on), and a log without landmarks is warned about, since nothing can

@@ -276,6 +276,9 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     })?;
     write_maps(&args.run_dir, &log, &mapped)?;
     print!("{}", mapped.summary.table());
+    if let Some(w) = swarmmap::pipeline::density_warning(&mapped.maps, &cfg.local.classifier) {
+        eprintln!("warning: {w}");
+    }
     if !log.encounters.is_empty() && mapped.summary.global.betti[0] == 0 {
         // Every component of every window was judged noise: the maps are empty although
         // the log is not (a log too sparse for its windows, or windows too short).

@@ -78,6 +78,12 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         }
     })?;
     print!("{}", mapped.summary.table());
+    let bank = swarmmap::mapping::pipeline::MapConfig::for_world(&world)
+        .local
+        .classifier;
+    if let Some(w) = swarmmap::pipeline::density_warning(&mapped.maps, &bank) {
+        eprintln!("warning: {w}");
+    }
     println!("outputs: {}", out.display());
     if !args.no_report {
         let written = swarmmap::report::write_report(&out).map_err(super::report::failure)?;

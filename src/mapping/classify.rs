@@ -95,6 +95,14 @@ pub struct Model {
     pub leader_speed: Option<f64>,
 }
 
+/// How much sparser than its training windows a window may be before `map` and `run` warn
+/// that its model was not made for it ([`Bank::too_sparse_for`]): half again. The shipped
+/// `Embedded` model's own training windows span a factor of 2.75 (4.39–12.08 encounters per
+/// vertex); the bundled worlds' windows hold at least 4.39 (seeds 1–20 of scenario 2 and 3
+/// and seed 1 of the others, fortieth session), and a log with a tenth of scenario 1's rows
+/// holds about 1.1.
+pub const DENSITY_MARGIN: f64 = 1.5;
+
 /// The sweep a model without a recorded `leader_speed` was fitted at: the default leader
 /// speed, that of every training world.
 pub const DEFAULT_SWEEP: f64 = 0.005;
@@ -391,6 +399,18 @@ impl Bank {
             .iter()
             .min_by(|a, b| far(a).total_cmp(&far(b)))
             .unwrap_or_else(|| self.first())
+    }
+
+    /// The training density of the model that judges a window of `events_per_point`
+    /// encounters per Rips vertex, when that window is sparser than its training windows by
+    /// more than [`DENSITY_MARGIN`] (below their least over the margin); `None` when it is
+    /// not, or the model recorded no density. A model does not carry to sparser clouds:
+    /// fitted at twice the density, it shows false holes there (docs/accuracy.md, steps 28
+    /// and 31). Denser windows are not flagged: no such failure was measured (the bundled
+    /// corridor's windows hold 38–52 encounters per vertex and map right).
+    pub fn too_sparse_for(&self, events_per_point: f64) -> Option<Density> {
+        let d = self.pick(events_per_point).events_per_point?;
+        (events_per_point < d.min / DENSITY_MARGIN).then_some(d)
     }
 
     /// The first model (the only one of a bank of one).
@@ -1015,6 +1035,22 @@ mod tests {
                 .contains("a model object or a list of model objects"),
             "{e}"
         );
+    }
+
+    /// A window is too sparse for a model below its training windows' least density over
+    /// the margin, and never for a model without a recorded density.
+    #[test]
+    fn too_sparse_is_below_the_least_density_over_the_margin() {
+        let mut model = Models::shipped().embedded.first().clone();
+        let d = model
+            .events_per_point
+            .expect("the shipped Embedded model records its density");
+        let bank = Bank(vec![model.clone()]);
+        assert_eq!(bank.too_sparse_for(d.min / DENSITY_MARGIN * 0.99), Some(d));
+        assert_eq!(bank.too_sparse_for(d.min / DENSITY_MARGIN * 1.01), None);
+        assert_eq!(bank.too_sparse_for(d.max * 10.0), None);
+        model.events_per_point = None;
+        assert_eq!(Bank(vec![model]).too_sparse_for(1e-3), None);
     }
 
     /// A model out of range is reported just after it, in a list or alone, and the message
