@@ -198,15 +198,46 @@ impl CsvFile {
                 ),
             });
         }
-        for r in required {
-            if !index.contains_key(*r) {
+        // A column named twice: rows would be read from one of the two in silence.
+        for (i, h) in headers.iter().enumerate() {
+            if let Some(j) = headers
+                .iter()
+                .skip(i + 1)
+                .position(|o| !h.is_empty() && o == h)
+            {
                 return Err(LogError::Csv {
                     path: path.to_path_buf(),
                     line: 1,
                     message: format!(
-                        "missing column `{r}`; the header must contain {} (found: {})",
+                        "the header names column `{}` twice (fields {} and {}); name each \
+                         column once",
+                        shown(h),
+                        i + 1,
+                        i + j + 2
+                    ),
+                });
+            }
+        }
+        for r in required {
+            if !index.contains_key(*r) {
+                let header = headers.iter().collect::<Vec<_>>().join(",");
+                // One field holding every name: another separator than the comma.
+                let separator = [(';', "`;`"), ('\t', "tabs"), ('|', "`|`")]
+                    .into_iter()
+                    .find(|(c, _)| headers.len() == 1 && header.contains(*c))
+                    .map_or(String::new(), |(_, name)| {
+                        format!(
+                            "; the file separates its fields with {name}: save it with commas \
+                             (comma-separated values)"
+                        )
+                    });
+                return Err(LogError::Csv {
+                    path: path.to_path_buf(),
+                    line: 1,
+                    message: format!(
+                        "missing column `{r}`; the header must contain {} (found: {}){separator}",
                         required.join(","),
-                        shown(&headers.iter().collect::<Vec<_>>().join(","))
+                        shown(&header)
                     ),
                 });
             }
@@ -257,7 +288,9 @@ fn csv_error<R>(path: &Path, lines: &LineIndex<R>, byte: u64, e: &csv::Error) ->
         } => format!(
             "this row has {len} fields but the header has {expected_len}; every row needs one value per column"
         ),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text; save the file as UTF-8 (a \
+             spreadsheet's \"Unicode text\" is UTF-16)"
+            .to_string(),
         _ => e.to_string(),
     };
     LogError::Csv {
@@ -352,8 +385,9 @@ impl Row<'_> {
         let s = self.text(name).unwrap_or("");
         s.parse().map_err(|_| {
             format!(
-                "column `{name}` is `{}`; agent ids are non-negative integers",
-                shown(s)
+                "column `{name}` is `{}`; agent ids are whole numbers from 0 to {}",
+                shown(s),
+                AgentId::MAX
             )
         })
     }
@@ -643,7 +677,7 @@ mod tests {
         );
         let e = error_of("start,end,a,b\n0,1,-1,1\n");
         assert!(
-            e.contains(":2: column `a` is `-1`; agent ids are non-negative integers"),
+            e.contains(":2: column `a` is `-1`; agent ids are whole numbers from 0 to 4294967295"),
             "{e}"
         );
         let e = error_of("start,end,a,b\n0,1,4,4\n");
@@ -663,6 +697,39 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
         assert!(e.contains("file not found"), "{e}");
+    }
+
+    /// Found by the fortieth session's review: a column named twice was read from its last
+    /// copy in silence; a file of semicolons or UTF-16 text got no hint of what to change.
+    #[test]
+    fn a_header_naming_a_column_twice_or_another_separator_is_explained() {
+        let e = error_of("start,end,a,b,a\n0,1,1,2,7\n");
+        assert!(
+            e.contains("encounters.csv:1: the header names column `a` twice (fields 3 and 5)"),
+            "{e}"
+        );
+        // Empty names (trailing commas) are no columns of ours: allowed.
+        let d = dir_with(&[("encounters.csv", "start,end,a,b,,\n0,1,1,2,,\n")]);
+        assert_eq!(
+            EncounterLog::read_dir(d.path()).unwrap().encounters.len(),
+            1
+        );
+        for (sep, name) in [(";", "`;`"), ("\t", "tabs")] {
+            let e = error_of(&format!("start{sep}end{sep}a{sep}b\n0{sep}1{sep}1{sep}2\n"));
+            assert!(
+                e.contains("missing column `start`")
+                    && e.contains(&format!("separates its fields with {name}")),
+                "{e}"
+            );
+        }
+        let utf16: Vec<u8> = "\u{feff}start,end,a,b\n0,1,1,2\n"
+            .encode_utf16()
+            .flat_map(u16::to_le_bytes)
+            .collect();
+        let d = tempfile::tempdir().unwrap();
+        std::fs::write(d.path().join("encounters.csv"), utf16).unwrap();
+        let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
+        assert!(e.contains("save the file as UTF-8"), "{e}");
     }
 
     fn leader_of(text: &str) -> Result<Vec<(f64, f64)>, String> {

@@ -992,12 +992,35 @@ fn a_control_character_in_a_cell_is_shown_escaped() {
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     lines[1] = lines[1].replacen(',', "\u{0},", 1);
     fs::write(run.join("trajectories.csv"), lines.join("\n") + "\n").unwrap();
+    swarmmap().arg("report").arg(&run).assert().code(2).stderr(
+        contains("trajectories.csv:2: column `time` is `")
+            .and(contains("\\0`, not a finite number")),
+    );
+}
+
+/// `trajectories.csv` errors name `file:line` as every other CSV reader does, counting the
+/// lines of the file, a blank one included (found by the fortieth session's review: they
+/// said "file: line N:", counting records).
+#[test]
+fn a_bad_trajectory_row_is_named_by_its_file_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "run");
+    let text = fs::read_to_string(run.join("trajectories.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    lines.insert(1, String::new());
+    lines[3] = lines[3]
+        .replace("walk", "run")
+        .replace("pause", "run")
+        .replace("landmark", "run");
+    fs::write(run.join("trajectories.csv"), lines.join("\n") + "\n").unwrap();
     swarmmap()
         .arg("report")
         .arg(&run)
         .assert()
         .code(2)
-        .stderr(contains("line 2: column `time` is `").and(contains("\\0`, not a finite number")));
+        .stderr(contains(
+            "trajectories.csv:4: state `run` is not walk, pause, landmark or return",
+        ));
 }
 
 #[test]

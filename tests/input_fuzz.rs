@@ -670,7 +670,7 @@ fn agent(name: &str, s: &str) -> Result<u32, Vec<String>> {
     s.parse::<u32>().map_err(|_| {
         vec![
             format!("column `{name}` is `{}`", shown(s)),
-            "agent ids are non-negative integers".into(),
+            "agent ids are whole numbers from 0 to 4294967295".into(),
         ]
     })
 }

@@ -116,11 +116,11 @@ fn bad_files_name_the_line_and_exit_2() {
         &[],
         ":3: row has 1 columns but line 1 has 2",
     );
-    bad("0,0\n1,x\n", &[], ":2: column 2: 'x' is not a number");
+    bad("0,0\n1,x\n", &[], ":2: field 2: 'x' is not a number");
     bad(
         "0,0\n1,nan\n",
         &[],
-        ":2: coordinate 1 of point 1 is not a finite number",
+        ":2: coordinate 1 of point 1 is not a finite number (field 2 of the line)",
     );
     // Regression: coordinates this large made every distance overflow to infinity, and
     // the diagram came out with every point an essential class, without a word.
@@ -138,7 +138,13 @@ fn bad_files_name_the_line_and_exit_2() {
     bad(
         "0,-1\n-1,0\n",
         &["--distance-matrix"],
-        ":1: entry (0, 1) is -1",
+        ":1: entry (0, 1) is -1; distances must be finite and non-negative (field 2 of the line)",
+    );
+    // A far entry is echoed with an exponent (found by the fortieth session's review).
+    bad(
+        "0,-1e200\n-1e200,0\n",
+        &["--distance-matrix"],
+        ":1: entry (0, 1) is -1e200;",
     );
     bad(
         "0,1,2\n1,0,1\n",
@@ -174,4 +180,24 @@ fn missing_file_is_an_input_error_as_for_every_command() {
         .stderr(predicate::str::contains(
             "cannot read /nonexistent/points.csv",
         ));
+}
+
+/// Far values are written with an exponent, exactly (found by the fortieth session's
+/// review: 1e149 came out as 150 digits); they read back to the same numbers.
+#[test]
+fn far_values_are_written_with_an_exponent() {
+    let f = temp_csv("0,0\n1e149,0\n2e149,1\n");
+    let out = cmd()
+        .args(["persistence", f.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.lines().all(|l| l.len() < 40), "{text}");
+    let deaths: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(deaths, [1e149, 1e149, f64::INFINITY]);
 }

@@ -99,7 +99,9 @@ fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
             Err(e) => {
                 let line = rdr.get_ref().line_of(e.position().map_or(at, |p| p.byte()));
                 let what = match e.kind() {
-                    csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+                    csv::ErrorKind::Utf8 { .. } => {
+                        "not valid UTF-8 text; save the file as UTF-8".to_string()
+                    }
                     _ => e.to_string(),
                 };
                 return Err(format!("{line}: {what}"));
@@ -112,7 +114,7 @@ fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
         for (col, field) in rec.iter().enumerate() {
             let v: f64 = field.parse().map_err(|_| {
                 format!(
-                    "{line}: column {}: '{field}' is not a number; every field must be a decimal number",
+                    "{line}: field {}: '{field}' is not a number; every field must be a decimal number",
                     col + 1
                 )
             })?;
@@ -156,9 +158,29 @@ fn located(file: &Path, rows: &[Row], e: MatrixError) -> anyhow::Error {
         | MatrixError::Asymmetric { row, .. } => Some(row),
         _ => None,
     };
+    // The library counts points and entries from 0; the file's fields from 1.
+    let col = match e {
+        MatrixError::NonFinite { col, .. }
+        | MatrixError::TooLarge { col, .. }
+        | MatrixError::BadEntry { col, .. }
+        | MatrixError::Asymmetric { col, .. } => Some(col),
+        _ => None,
+    };
+    let field = col.map_or(String::new(), |c| format!(" (field {} of the line)", c + 1));
     match row.and_then(|r| rows.get(r)) {
-        Some((line, _)) => anyhow!("{}:{line}: {e}", file.display()),
+        Some((line, _)) => anyhow!("{}:{line}: {e}{field}", file.display()),
         None => anyhow!("{}: {e}", file.display()),
+    }
+}
+
+/// A number of the output: exactly (Rust's shortest round-trip digits), with an exponent
+/// where the plain form would run to many digits (|x| ≥ 1e16 or below 1e-6): `1e149`, not
+/// 150 digits.
+fn csv_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-6..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }
 
@@ -170,7 +192,13 @@ pub fn write_diagram(w: &mut dyn Write, d: &Diagram, cycles: bool) -> std::io::R
         if cycles { ",cycle,void" } else { "" }
     )?;
     for b in &d.bars {
-        write!(w, "{},{},{}", b.dim, b.birth, b.death)?;
+        write!(
+            w,
+            "{},{},{}",
+            b.dim,
+            csv_number(b.birth),
+            csv_number(b.death)
+        )?;
         if cycles {
             let c = b.cycle.as_deref().unwrap_or(&[]);
             let s: Vec<String> = c.iter().map(|(i, j)| format!("{i}-{j}")).collect();

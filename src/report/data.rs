@@ -195,6 +195,14 @@ fn listed_exists(summary: &Path, path: &Path, what: &str, index: usize) -> Resul
     ))
 }
 
+fn invalid_line(path: &Path, line: u64, message: impl Into<String>) -> ReportError {
+    ReportError::InvalidLine {
+        path: path.to_path_buf(),
+        line,
+        message: message.into(),
+    }
+}
+
 fn invalid(path: &Path, message: impl Into<String>) -> ReportError {
     ReportError::Invalid {
         path: path.to_path_buf(),
@@ -312,7 +320,7 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
         .from_reader(file);
     let headers = reader
         .headers()
-        .map_err(|e| invalid(path, format!("line 1: {e}")))?;
+        .map_err(|e| invalid_line(path, 1, e.to_string()))?;
     let expected = ["time", "agent", "x", "y", "state"];
     if headers.is_empty() {
         return Err(invalid(
@@ -324,15 +332,19 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
         ));
     }
     if headers.iter().collect::<Vec<_>>() != expected {
-        return Err(invalid(
+        return Err(invalid_line(
             path,
-            format!("line 1: the header must be {}", expected.join(",")),
+            1,
+            format!("the header must be {}", expected.join(",")),
         ));
     }
     let mut out = Vec::new();
-    for (k, record) in reader.records().enumerate() {
-        let line = k + 2;
-        let record = record.map_err(|e| invalid(path, format!("line {line}: {e}")))?;
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            let line = e.position().map_or(0, csv::Position::line);
+            invalid_line(path, line, e.to_string())
+        })?;
+        let line = record.position().map_or(0, csv::Position::line);
         let field = |i: usize| record.get(i).unwrap_or("");
         let num = |i: usize| -> Result<f64, ReportError> {
             field(i)
@@ -340,10 +352,11 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
-                    invalid(
+                    invalid_line(
                         path,
+                        line,
                         format!(
-                            "line {line}: column `{}` is `{}`, not a finite number",
+                            "column `{}` is `{}`, not a finite number",
                             expected[i],
                             crate::log::shown(field(i))
                         ),
@@ -351,10 +364,11 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
                 })
         };
         let agent: u32 = field(1).parse().map_err(|_| {
-            invalid(
+            invalid_line(
                 path,
+                line,
                 format!(
-                    "line {line}: column `agent` is `{}`, not an agent id",
+                    "column `agent` is `{}`, not an agent id",
                     crate::log::shown(field(1))
                 ),
             )
@@ -365,10 +379,11 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
             "landmark" => 2,
             "return" => 3,
             other => {
-                return Err(invalid(
+                return Err(invalid_line(
                     path,
+                    line,
                     format!(
-                        "line {line}: state `{}` is not walk, pause, landmark or return",
+                        "state `{}` is not walk, pause, landmark or return",
                         crate::log::shown(other)
                     ),
                 ));

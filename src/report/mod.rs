@@ -41,6 +41,13 @@ pub enum ReportError {
     /// A file exists but is not what a run writes.
     #[error("{path}: {message}")]
     Invalid { path: PathBuf, message: String },
+    /// A line of a CSV file is not what a run writes.
+    #[error("{path}:{line}: {message}")]
+    InvalidLine {
+        path: PathBuf,
+        line: u64,
+        message: String,
+    },
     /// The encounter log could not be read.
     #[error(transparent)]
     Log(#[from] LogError),
@@ -64,7 +71,9 @@ impl ReportError {
     /// machine or the program.
     pub fn is_input(&self) -> bool {
         match self {
-            ReportError::Missing { .. } | ReportError::Invalid { .. } => true,
+            ReportError::Missing { .. }
+            | ReportError::Invalid { .. }
+            | ReportError::InvalidLine { .. } => true,
             ReportError::Log(_) => true,
             ReportError::Meta(e) => e.is_input(),
             ReportError::Plot { .. } | ReportError::Write { .. } => false,

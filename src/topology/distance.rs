@@ -5,6 +5,7 @@
 //! That halves the memory of a full matrix, which matters for persistence on a few
 //! thousand points.
 
+use super::rips::written;
 use thiserror::Error;
 
 /// `n` points in `dim` dimensions, stored row-major in one flat vector.
@@ -261,7 +262,8 @@ pub enum MatrixError {
     #[error("coordinate {col} of point {row} is not a finite number")]
     NonFinite { row: usize, col: usize },
     #[error(
-        "coordinate {col} of point {row} is {value:e}, beyond ±1e150: squared distances would overflow; rescale the points"
+        "coordinate {col} of point {row} is {}, beyond ±1e150: squared distances would overflow; rescale the points",
+        written(*.value)
     )]
     TooLarge { row: usize, col: usize, value: f64 },
     #[error("a condensed matrix for this many points needs {want} entries, got {len}")]
@@ -270,12 +272,20 @@ pub enum MatrixError {
         "row {row} has {len} entries but the matrix has {n} rows; a distance matrix must be square"
     )]
     NotSquare { row: usize, len: usize, n: usize },
-    #[error("diagonal entry ({row}, {row}) is {value}; a point is at distance 0 from itself")]
+    #[error(
+        "diagonal entry ({row}, {row}) is {}; a point is at distance 0 from itself",
+        written(*.value)
+    )]
     Diagonal { row: usize, value: f64 },
-    #[error("entry ({row}, {col}) is {value}; distances must be finite and non-negative")]
+    #[error(
+        "entry ({row}, {col}) is {}; distances must be finite and non-negative",
+        written(*.value)
+    )]
     BadEntry { row: usize, col: usize, value: f64 },
     #[error(
-        "entries ({row}, {col}) = {a} and ({col}, {row}) = {b} differ; a distance matrix must be symmetric"
+        "entries ({row}, {col}) = {} and ({col}, {row}) = {} differ; a distance matrix must be symmetric",
+        written(*.a),
+        written(*.b)
     )]
     Asymmetric {
         row: usize,

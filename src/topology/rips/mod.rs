@@ -36,6 +36,7 @@ mod params;
 mod tight;
 
 pub use diagram::{Bar, Diagram};
+pub(crate) use params::written;
 pub use params::{RipsError, RipsOptions};
 pub use tight::tighten_cycle;
 

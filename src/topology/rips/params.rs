@@ -47,7 +47,7 @@ impl RipsOptions {
 /// A number as the command line's messages write it (as `world::given` does; the topology
 /// engine depends on no other module): exactly, with an exponent outside 1e-6 ≤ |x| < 1e9
 /// (`-1e300`, not hundreds of digits).
-fn written(x: f64) -> String {
+pub(crate) fn written(x: f64) -> String {
     if x == 0.0 || !x.is_finite() || (1e-6..1e9).contains(&x.abs()) {
         format!("{x}")
     } else {
