@@ -258,6 +258,45 @@ fn map_warns_of_windows_far_sparser_than_the_models_training() {
     assert!(!fine.contains("Rips vertex"), "{fine}");
 }
 
+/// A static interval far beyond the encounters (a mistyped end) stretches the windows: the
+/// empty window is warned about, and a cluster that reaches only one map is no connection
+/// (found by the fortieth session's review: "connections 1–2: 1" was printed beside an
+/// empty window 2, in silence).
+#[test]
+fn an_empty_window_is_warned_about_and_joins_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
+    let path = log.join("static_intervals.csv");
+    let mut text = fs::read_to_string(&path).unwrap();
+    let first = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .to_string();
+    text.push_str(&format!("{first},0,1000000000,landmark\n"));
+    fs::write(&path, text).unwrap();
+    let out = swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("window 2 holds no encounter")
+            && stderr.contains("but the windows are cut over 0–1e9 s"),
+        "{stderr}"
+    );
+    let s = json(&log.join("summary.json"));
+    assert_eq!(s["windows"][1]["events"], 0, "{s}");
+    assert_eq!(s["connections"][0]["count"], 0, "{s}");
+    let c = json(&log.join("maps/connections.json"));
+    assert_eq!(c[0]["joins"].as_array().unwrap().len(), 0);
+}
+
 /// `--method embedded` on a real log, with and without landmark intervals: every window
 /// keeps its component (the method falls back to all encounters where it has no landmark
 /// encounters to anchor on), and a log without landmarks is warned about, since nothing can

@@ -279,6 +279,9 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     if let Some(w) = swarmmap::pipeline::density_warning(&mapped.maps, &cfg.local.classifier) {
         eprintln!("warning: {w}");
     }
+    if let Some(w) = empty_windows(&log, &mapped.maps, cfg.span, world.is_some()) {
+        eprintln!("warning: {w}");
+    }
     if !log.encounters.is_empty() && mapped.summary.global.betti[0] == 0 {
         // Every component of every window was judged noise: the maps are empty although
         // the log is not (a log too sparse for its windows, or windows too short).
@@ -296,6 +299,47 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         println!("report refreshed: {}", page.display());
     }
     Ok(())
+}
+
+/// A warning when some windows hold no encounter although the log has some: the windows
+/// are cut over a span (the run's, or the log's with its static intervals) that the
+/// encounters do not fill, as a mistyped end in `static_intervals.csv` or a log of part of
+/// a run makes it. `None` when every window holds encounters, or the log none.
+fn empty_windows(
+    log: &EncounterLog,
+    maps: &[swarmmap::mapping::local::LocalMap],
+    span: (f64, f64),
+    with_world: bool,
+) -> Option<String> {
+    let empty: Vec<String> = maps
+        .iter()
+        .filter(|m| m.events.is_empty())
+        .map(|m| m.index.to_string())
+        .collect();
+    let first = log.encounters.iter().map(|e| e.start).reduce(f64::min)?;
+    let last = log.encounters.iter().map(|e| e.end).reduce(f64::max)?;
+    if empty.is_empty() {
+        return None;
+    }
+    let why = if with_world {
+        "the run's span, from its world: is this log the whole run?".to_string()
+    } else {
+        "the span of the encounters and of static_intervals.csv together: a row of \
+         static_intervals.csv far outside the encounters' times, such as a mistyped time, \
+         stretches every window; correct it, or pass --world for the run's own span"
+            .to_string()
+    };
+    Some(format!(
+        "window{} {} {} no encounter: the log's encounters span {}–{} s, but the windows are \
+         cut over {}–{} s ({why})",
+        if empty.len() == 1 { "" } else { "s" },
+        empty.join(", "),
+        if empty.len() == 1 { "holds" } else { "hold" },
+        short(first),
+        short(last),
+        short(span.0),
+        short(span.1)
+    ))
 }
 
 /// Where a log and the world it is mapped with disagree: encounters outside the run's span

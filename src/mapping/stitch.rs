@@ -12,7 +12,10 @@
 //! W_i ∪ W_{i+1} (the correspondence metric). Single linkage of the cloud, cut at c
 //! (default 50 s, the paper's value), gives the clusters; each cluster is one connection.
 //! The components of M_i and M_{i+1} that a cluster's events belong to are the components
-//! the connection joins.
+//! the connection joins. A cluster none of whose events lies in a component of one of the
+//! two maps (that map judged them all noise, or holds no events at all) joins nothing and
+//! is not counted: a connection is between the maps, and the global map's edges are the
+//! joins (on the bundled worlds every cluster joins, so this changes none of their counts).
 //!
 //! # The global map and its Betti numbers
 //!
@@ -106,7 +109,8 @@ pub struct Connection {
     pub metric: Option<DistanceMatrix>,
     /// Single-linkage merge heights (ascending).
     pub heights: Vec<f64>,
-    /// Number of connections (clusters).
+    /// Number of connections: the clusters that join a component of each map (one per
+    /// entry of `joins`).
     pub count: usize,
     /// Pairs `(component of M_i, component of M_{i+1})` joined, one per cluster that
     /// touches both maps.
@@ -220,10 +224,10 @@ pub fn connect(
     });
     let dendrogram = single_linkage(&metric);
     let labels = dendrogram.cut(p.cutoff);
-    let count = labels.iter().copied().max().map_or(0, |m| m + 1);
+    let clusters = labels.iter().copied().max().map_or(0, |m| m + 1);
     // Which components each cluster touches, through all E_S events of its anchors.
     let (ca, cb) = (component_of_events(ma), component_of_events(mb));
-    let mut touch: Vec<(BTreeSet<usize>, BTreeSet<usize>)> = vec![Default::default(); count];
+    let mut touch: Vec<(BTreeSet<usize>, BTreeSet<usize>)> = vec![Default::default(); clusters];
     for (point, &label) in cloud.iter().zip(&labels) {
         let anchor_events = anchors
             .values()
@@ -240,10 +244,12 @@ pub fn connect(
             }
         }
     }
-    let joins = touch
+    let joins: Vec<(usize, usize)> = touch
         .iter()
         .filter_map(|(a, b)| Some((*a.first()?, *b.first()?)))
         .collect();
+    // Only the clusters that join the two maps are connections between them.
+    let count = joins.len();
     Connection {
         between: [wa.index, wb.index],
         static_agents: anchors.keys().copied().collect(),

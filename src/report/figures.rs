@@ -642,6 +642,17 @@ fn cycles_of<'w>(
 /// (5 000+ events each) small enough to mail without changing what the cloud looks like.
 pub const MAX_CLOUD_POINTS: usize = 1000;
 
+/// The clusters of a connection's cloud as a caption says them: their number, and how many
+/// of them join the two maps when not all do (`count`, [`crate::mapping::stitch`]).
+fn clusters_said(conn: &ConnectionIn) -> String {
+    let clusters = conn.points.iter().map(|p| p.label + 1).max().unwrap_or(0);
+    if clusters == conn.count {
+        format!("{clusters} cluster(s)")
+    } else {
+        format!("{clusters} cluster(s), {} joining both maps", conn.count)
+    }
+}
+
 /// The stride that draws at most [`MAX_CLOUD_POINTS`] of `n` points.
 fn stride(n: usize) -> usize {
     n.div_ceil(MAX_CLOUD_POINTS).max(1)
@@ -775,10 +786,7 @@ pub fn pair_cloud(run: &RunData, conn: &ConnectionIn) -> Result<Figure, ReportEr
         let pts: Vec<(f64, f64)> = conn.points.iter().map(|p| (p.xy[0], p.xy[1])).collect();
         let mut c = chart(
             &panels[0],
-            &format!(
-                "M{i}–M{j}: {} cluster(s), c = {} s",
-                conn.count, conn.cutoff
-            ),
+            &format!("M{i}–M{j}: {}, c = {} s", clusters_said(conn), conn.cutoff),
             span(pts.iter().map(|p| p.0)),
             span(pts.iter().map(|p| p.1)),
             "MDS coordinate 1 (s)",
@@ -886,10 +894,7 @@ pub fn dendrogram(conn: &ConnectionIn) -> Result<Figure, ReportError> {
     let svg = render(&name, (width, 340), |root| {
         let mut c = chart(
             root,
-            &format!(
-                "M{i}–M{j}: single linkage, {} cluster(s) below c",
-                conn.count
-            ),
+            &format!("M{i}–M{j}: single linkage, {} below c", clusters_said(conn)),
             (-1.0, n.max(1) as f64),
             (0.0, 1.22 * top),
             "points of the inter-domain cloud (leaf order)",
