@@ -404,6 +404,14 @@ pub struct ReadNotes {
     /// Rows of `encounters.csv` that repeat an earlier row exactly (the same start, end and
     /// agents): each is read as one more encounter.
     pub repeated_encounters: usize,
+    /// Encounters that overlap in time an earlier encounter of the same two agents without
+    /// repeating it exactly. One contact is one interval, so such rows are one contact
+    /// recorded twice (each robot logging it, with its own clock) or a logger's fault;
+    /// each is read as one more encounter.
+    pub overlapping_encounters: usize,
+    /// Static intervals of `static_intervals.csv` that overlap an earlier one of the same
+    /// agent (an agent stands at one place at a time).
+    pub overlapping_static: usize,
 }
 
 impl EncounterLog {
@@ -432,6 +440,12 @@ impl EncounterLog {
         if st.exists() {
             log.static_intervals = read_static(&st)?;
         }
+        let mut notes = notes;
+        notes.overlapping_static = log
+            .static_intervals
+            .windows(2)
+            .filter(|w| w[0].agent == w[1].agent && w[1].start < w[0].end)
+            .count();
         let le = dir.join(LEADER_CSV);
         if le.exists() {
             log.leader = read_leader(&le)?;
@@ -522,9 +536,27 @@ fn read_encounters(path: &Path) -> Result<(Vec<Encounter>, ReadNotes), LogError>
         .count();
     // Stable: rows equal in (start, a, b) keep the file's order.
     out.sort_by(order);
+    // Each pair's latest interval so far, in start order: a later one starting before it
+    // ends (and not an exact repeat, counted above) overlaps it.
+    let mut last: HashMap<(AgentId, AgentId), (f64, f64)> = HashMap::new();
+    let mut overlapping_encounters = 0;
+    for e in &out {
+        if let Some(&(start, end)) = last.get(&(e.a, e.b))
+            && e.start < end
+            && (start, end) != (e.start, e.end)
+        {
+            overlapping_encounters += 1;
+        }
+        let keep = last.get(&(e.a, e.b)).is_none_or(|&(_, end)| e.end > end);
+        if keep {
+            last.insert((e.a, e.b), (e.start, e.end));
+        }
+    }
     let notes = ReadNotes {
         encounters_in_order,
         repeated_encounters,
+        overlapping_encounters,
+        overlapping_static: 0,
     };
     Ok((out, notes))
 }
@@ -697,6 +729,28 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let e = EncounterLog::read_dir(d.path()).unwrap_err().to_string();
         assert!(e.contains("file not found"), "{e}");
+    }
+
+    /// Rows overlapping an earlier encounter of the same pair (each robot logging the
+    /// contact) and static intervals overlapping one of the same agent are counted; an exact
+    /// repeat is counted as a repeat only, and touching intervals are no overlap.
+    #[test]
+    fn overlapping_rows_of_one_pair_or_agent_are_noted() {
+        let d = dir_with(&[
+            (
+                "encounters.csv",
+                "start,end,a,b\n0,2,1,2\n1.5,3,2,1\n0,2,1,2\n3,4,1,2\n5,6,1,3\n",
+            ),
+            (
+                "static_intervals.csv",
+                "agent,start,end,reason\n1,0,10,landmark\n1,10,12,pause\n1,11,20,landmark\n",
+            ),
+        ]);
+        let (log, notes) = EncounterLog::read_dir_noting(d.path()).unwrap();
+        assert_eq!(log.encounters.len(), 5);
+        assert_eq!(notes.repeated_encounters, 1);
+        assert_eq!(notes.overlapping_encounters, 1);
+        assert_eq!(notes.overlapping_static, 1);
     }
 
     /// Found by the fortieth session's review: a column named twice was read from its last

@@ -191,6 +191,24 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             notes.repeated_encounters
         );
     }
+    if notes.overlapping_encounters > 0 {
+        eprintln!(
+            "warning: {} has {} row(s) overlapping in time an earlier encounter of the same \
+             two agents; one contact is one interval, so these are contacts recorded twice \
+             (as when each robot logs the encounter with its own clock) and each is mapped as \
+             one more encounter: keep one robot's rows, or merge each pair's overlapping rows",
+            encounters_csv.display(),
+            notes.overlapping_encounters
+        );
+    }
+    if notes.overlapping_static > 0 {
+        eprintln!(
+            "warning: {} has {} interval(s) overlapping an earlier one of the same agent; an \
+             agent stands at one place at a time: merge them, or correct the times",
+            args.run_dir.join("static_intervals.csv").display(),
+            notes.overlapping_static
+        );
+    }
     if let Some(w) = &world {
         for line in disagreements(&log, w, cfg.span) {
             eprintln!("warning: {line}");
