@@ -271,3 +271,21 @@ fn remapping_refreshes_an_existing_report() {
         "the page describes the new maps"
     );
 }
+
+/// A report interrupted before its page was written (figures, no `index.html`) is made
+/// again by the next `map`, not dropped (found by the fortieth session's review: only a
+/// report with its page counted as existing, and the stale figures were just deleted).
+#[test]
+fn remapping_completes_a_report_interrupted_before_its_page() {
+    let (_tmp, dir) = fixture_copy();
+    swarmmap().arg("report").arg(&dir).assert().success();
+    fs::remove_file(dir.join("report/index.html")).unwrap();
+    swarmmap()
+        .args(["map", "--windows", "3", "--overlap", "30"])
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("report refreshed"));
+    assert!(dir.join("report/index.html").exists());
+    assert!(dir.join("report/window_3_cloud.svg").exists());
+}

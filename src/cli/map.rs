@@ -106,7 +106,10 @@ fn mapping_sets(args: &MapArgs) -> Result<MappingParams, Failure> {
 }
 
 pub fn run(args: &MapArgs) -> Result<(), Failure> {
-    let (log, notes) = EncounterLog::read_dir_noting(&args.run_dir).map_err(input)?;
+    let mut timings = Timings::default();
+    let (log, notes) = timings
+        .time("reading", || EncounterLog::read_dir_noting(&args.run_dir))
+        .map_err(input)?;
     let defaults = mapping_sets(args)?;
     let world = match &args.world {
         Some(path) => Some(load_world(path, &args.set)?),
@@ -266,7 +269,6 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             args.run_dir.display()
         );
     }
-    let mut timings = Timings::default();
     // The run's seed (a real log has none): a world file's `seed` field says nothing about
     // which seed produced this log.
     let seed = seed_from_run(&args.run_dir).map_err(input)?;
@@ -287,7 +289,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     // the figures of a report interrupted earlier) and, if there was one, is made again
     // from the new ones.
     let page = args.run_dir.join("report").join("index.html");
-    let had_report = page.exists();
+    let had_report = swarmmap::report::has_report(&args.run_dir);
     swarmmap::report::remove_report(&args.run_dir).map_err(|source| PipelineError::Write {
         path: args.run_dir.join("report"),
         source,
@@ -305,11 +307,15 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         // the log is not (a log too sparse for its windows, or windows too short).
         eprintln!(
             "warning: every window's encounters were judged noise (β0 = 0 everywhere) although \
-             {} holds {} encounter(s): the log is too sparse for {} window(s); map it with \
-             fewer --windows, or record more encounters",
+             {} holds {} encounter(s): the log is too sparse for {} window(s); {}",
             encounters_csv.display(),
             log.encounters.len(),
-            cfg.windows
+            cfg.windows,
+            if cfg.windows > 1 {
+                "map it with fewer --windows, or record more encounters"
+            } else {
+                "record more encounters"
+            }
         );
     }
     if had_report {

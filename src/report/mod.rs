@@ -128,8 +128,23 @@ pub fn remove_report(dir: &Path) -> std::io::Result<()> {
     let out = dir.join("report");
     let none = std::collections::BTreeSet::new();
     crate::io::remove_stale(&out, &none, |n| n == "index.html")?;
-    crate::io::remove_stale(&out, &none, |n| {
-        matches!(n, "environment.svg" | "global.svg") || crate::io::is_numbered_figure(n)
+    crate::io::remove_stale(&out, &none, is_report_figure)
+}
+
+/// Whether `name` is one of the figures a report writes.
+fn is_report_figure(name: &str) -> bool {
+    matches!(name, "environment.svg" | "global.svg") || crate::io::is_numbered_figure(name)
+}
+
+/// Whether `dir/report/` holds a report, or part of one: the figures a report interrupted
+/// before its page was written leaves (`map` then makes the whole report again).
+pub fn has_report(dir: &Path) -> bool {
+    std::fs::read_dir(dir.join("report")).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            name == "index.html" || is_report_figure(&name)
+        })
     })
 }
 
