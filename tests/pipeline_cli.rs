@@ -322,7 +322,8 @@ fn the_embedded_method_maps_a_log_with_or_without_landmarks() {
     };
     let with = map(&log);
     let stderr = String::from_utf8(with.get_output().stderr.clone()).unwrap();
-    assert!(!stderr.contains("warning"), "{stderr}");
+    // (The tiny log is far sparser than the model's training windows: that is warned of.)
+    assert!(!stderr.contains("no landmark static intervals"), "{stderr}");
     let s = json(&log.join("summary.json"));
     assert!(
         s["windows"]
@@ -606,7 +607,7 @@ fn a_model_file_replaces_the_shipped_thresholds() {
         // message named only the file), and the place given once, not again at its end.
         (
             &out_of_range,
-            "range.json:9:3: the Embedded model's thresholds (h0_ratio",
+            "range.json:14:3: the Embedded model's thresholds (h0_ratio",
         ),
         (
             &broken,
