@@ -186,7 +186,7 @@ fn missing_or_malformed_inputs_exit_2_and_name_the_file() {
         .arg(&d5)
         .assert()
         .code(2)
-        .stderr(contains("trajectories.csv").and(contains("line 2")));
+        .stderr(contains("trajectories.csv:2: state `flying`"));
     // Nothing was written for a failed report.
     assert!(!d5.join("report").exists());
 }
