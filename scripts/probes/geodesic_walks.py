@@ -30,14 +30,13 @@ their obstacles, and the geometric mean of the weakest obstacle bar over the str
 other bar.
 """
 import bisect
-import csv
 import json
 import math
 import sys
 
 import numpy as np
 
-from straight_walks import alpha_bars, similarity
+from straight_walks import alpha_bars, read_run, similarity
 
 V = 0.1
 WIDTH = 0.15
@@ -113,21 +112,7 @@ def geodesic_places(events, site_pos, landmark_at, times):
 
 
 def probe(run):
-    meta = json.load(open(f"{run}/meta.json"))
-    summary = json.load(open(f"{run}/summary.json"))
-    obstacles = meta["world"]["obstacles"]
-    landmarks = {}
-    for r in csv.DictReader(open(f"{run}/static_intervals.csv")):
-        if r["reason"] == "landmark":
-            landmarks.setdefault(int(r["agent"]), []).append((float(r["start"]), float(r["end"])))
-
-    def site_of(agent, t):
-        for k, (s, e) in enumerate(landmarks.get(agent, [])):
-            if s <= t <= e:
-                return (agent, k)
-        return None
-
-    rows = list(csv.DictReader(open(f"{run}/encounters.csv")))
+    summary, obstacles, rows, site_of = read_run(run)
     for ws in summary["windows"]:
         window = json.load(open(f"{run}/maps/window_{ws['index']}.json"))
         events = window["events"]

@@ -97,12 +97,11 @@ def walk_cloud(sites, pos, walks):
     return np.array(pts)
 
 
-def probe(run):
-    from scipy.spatial import cKDTree
-
+def read_run(run):
+    """A run directory's summary, obstacles, encounter rows and `site_of(agent, t)`: the
+    landmark site (agent, k-th landmark interval) an agent stands at at time t, or None."""
     meta = json.load(open(f"{run}/meta.json"))
     summary = json.load(open(f"{run}/summary.json"))
-    obstacles = meta["world"]["obstacles"]
     landmarks = {}
     for r in csv.DictReader(open(f"{run}/static_intervals.csv")):
         if r["reason"] == "landmark":
@@ -115,6 +114,13 @@ def probe(run):
         return None
 
     rows = list(csv.DictReader(open(f"{run}/encounters.csv")))
+    return summary, meta["world"]["obstacles"], rows, site_of
+
+
+def probe(run):
+    from scipy.spatial import cKDTree
+
+    summary, obstacles, rows, site_of = read_run(run)
     for ws in summary["windows"]:
         window = json.load(open(f"{run}/maps/window_{ws['index']}.json"))
         placed = {ev["encounter"]: ev["point"][:2] for ev in window["events"]}
