@@ -9,7 +9,8 @@
 //! temporary file is half written. [`install_interrupt_handler`] (called by the command
 //! line) catches Ctrl-C (SIGINT, SIGTERM, SIGHUP), removes the temporary files still in
 //! flight (every target keeps its previous content or is absent) and exits with status
-//! 130, so an interrupted run leaves only whole files behind, and no debris.
+//! 130, so an interrupted run leaves only whole files behind, and no debris. A hang-up the
+//! process started to ignore (SIGHUP under `nohup`) stays ignored.
 
 use std::fs;
 use std::io::{self, Write};
@@ -29,15 +30,48 @@ pub const INTERRUPTED_STATUS: i32 = 130;
 /// Installs the process-wide Ctrl-C handler described in the module docs. Call it once,
 /// from a binary; a second call returns an error.
 pub fn install_interrupt_handler() -> Result<(), ctrlc::Error> {
+    // A hang-up the process was started to ignore (`nohup`) stays ignored: the handler
+    // would override it. (SIGINT, which a shell script's background jobs start ignoring,
+    // is still caught: only an explicit `kill -INT` reaches them, and it means stop.)
+    #[cfg(unix)]
+    let ignored: Vec<libc::c_int> = [libc::SIGHUP]
+        .into_iter()
+        .filter(|&s| is_ignored(s))
+        .collect();
     ctrlc::set_handler(|| {
         // Held until exit: no write may register (or rename) a file after the sweep.
         let files = in_flight();
         for f in files.iter() {
             let _ = fs::remove_file(f);
         }
-        eprintln!("interrupted: files already written are complete; partial ones were removed");
+        // Not `eprintln!`, which panics when stderr is gone (the terminal that hung up):
+        // the handler must reach the exit.
+        let _ = writeln!(
+            io::stderr(),
+            "interrupted: files already written are complete; partial ones were removed"
+        );
         std::process::exit(INTERRUPTED_STATUS);
-    })
+    })?;
+    #[cfg(unix)]
+    for s in ignored {
+        // SAFETY: `signal` with `SIG_IGN` installs no handler code; it restores the
+        // disposition the process was started with.
+        unsafe {
+            libc::signal(s, libc::SIG_IGN);
+        }
+    }
+    Ok(())
+}
+
+/// Whether the process was started with signal `s` ignored.
+#[cfg(unix)]
+fn is_ignored(s: libc::c_int) -> bool {
+    // SAFETY: `sigaction` with a null new action only reads the current one into `old`,
+    // a zeroed plain-data struct it fully owns.
+    unsafe {
+        let mut old: libc::sigaction = std::mem::zeroed();
+        libc::sigaction(s, std::ptr::null(), &mut old) == 0 && old.sa_sigaction == libc::SIG_IGN
+    }
 }
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, fsync, rename).

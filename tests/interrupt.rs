@@ -253,3 +253,36 @@ fn sigterm_and_sighup_are_handled_like_ctrl_c() {
         }
     }
 }
+
+#[test]
+fn a_run_started_under_nohup_ignores_the_hang_up() {
+    // Found by the fortieth session's review: with SIGHUP caught, `nohup swarmmap ...` lost
+    // its protection (the handler replaced the ignored disposition and stopped the run).
+    if Command::new("nohup").arg("true").status().is_err() {
+        eprintln!("no `nohup` on this machine: skipped");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let mut child = Command::new("nohup")
+        .arg(env!("CARGO_BIN_EXE_swarmmap"))
+        .args(["simulate", "worlds/scenario2.ron", "--quiet", "--out"])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    let _ = Command::new("kill")
+        .args(["-HUP", &child.id().to_string()])
+        .status();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the run stopped on a hang-up it was started to ignore"
+    );
+    let _ = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status();
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+}
