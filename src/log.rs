@@ -288,9 +288,7 @@ fn csv_error<R>(path: &Path, lines: &LineIndex<R>, byte: u64, e: &csv::Error) ->
         } => format!(
             "this row has {len} fields but the header has {expected_len}; every row needs one value per column"
         ),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text; save the file as UTF-8 (a \
-             spreadsheet's \"Unicode text\" is UTF-16)"
-            .to_string(),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text; save the file as UTF-8".to_string(),
         _ => e.to_string(),
     };
     LogError::Csv {
@@ -441,11 +439,18 @@ impl EncounterLog {
             log.static_intervals = read_static(&st)?;
         }
         let mut notes = notes;
-        notes.overlapping_static = log
-            .static_intervals
-            .windows(2)
-            .filter(|w| w[0].agent == w[1].agent && w[1].start < w[0].end)
-            .count();
+        // Sorted by (agent, start): an interval overlaps an earlier one of its agent when
+        // it starts before the latest end so far (a long interval can hold several).
+        let mut latest: Option<(AgentId, f64)> = None;
+        for s in &log.static_intervals {
+            match latest {
+                Some((agent, end)) if agent == s.agent => {
+                    notes.overlapping_static += usize::from(s.start < end);
+                    latest = Some((agent, end.max(s.end)));
+                }
+                _ => latest = Some((s.agent, s.end)),
+            }
+        }
         let le = dir.join(LEADER_CSV);
         if le.exists() {
             log.leader = read_leader(&le)?;
@@ -743,14 +748,16 @@ mod tests {
             ),
             (
                 "static_intervals.csv",
-                "agent,start,end,reason\n1,0,10,landmark\n1,10,12,pause\n1,11,20,landmark\n",
+                "agent,start,end,reason\n1,0,10,landmark\n1,10,12,pause\n1,11,20,landmark\n\
+                 2,0,100,landmark\n2,10,20,pause\n2,30,40,pause\n2,50,60,pause\n",
             ),
         ]);
         let (log, notes) = EncounterLog::read_dir_noting(d.path()).unwrap();
         assert_eq!(log.encounters.len(), 5);
         assert_eq!(notes.repeated_encounters, 1);
         assert_eq!(notes.overlapping_encounters, 1);
-        assert_eq!(notes.overlapping_static, 1);
+        // Agent 1's third interval; agent 2's three pauses inside its long landmark one.
+        assert_eq!(notes.overlapping_static, 4);
     }
 
     /// Found by the fortieth session's review: a column named twice was read from its last

@@ -140,12 +140,20 @@ pub fn density_warning(maps: &[LocalMap], bank: &crate::mapping::classify::Bank)
             )
         }
     };
+    // Fewer Rips points would quiet the warning without making the log denser: the
+    // stitching of such a log still splinters (scenario 1's log thinned to a tenth, at 300
+    // points: every window right, connections 14, 8 and 11, global β1 30), so it is not
+    // offered as the fix.
+    let more = if maps.len() > 1 {
+        "record more encounters per window (fewer windows: mapping.windows, map's --windows)"
+    } else {
+        "record more encounters"
+    };
     Some(format!(
         "{which} {verb} {held} encounters per Rips vertex, far fewer than the {}–{} of the \
          windows the classifier was fitted on: on such sparse clouds its thresholds show \
-         noise loops as holes; record more encounters per window (fewer --windows), sample \
-         the planar Rips complex with fewer points (--set mapping.rips_points=N), or fit a \
-         model at this density (swarmmap calibrate)",
+         noise loops as holes, and the stitching splits; {more}, or fit a model at this \
+         density (swarmmap calibrate)",
         crate::world::short(d.min),
         crate::world::short(d.max),
     ))

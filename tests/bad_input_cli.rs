@@ -1012,15 +1012,19 @@ fn a_bad_trajectory_row_is_named_by_its_file_line() {
         .replace("walk", "run")
         .replace("pause", "run")
         .replace("landmark", "run");
-    fs::write(run.join("trajectories.csv"), lines.join("\n") + "\n").unwrap();
-    swarmmap()
-        .arg("report")
-        .arg(&run)
-        .assert()
-        .code(2)
-        .stderr(contains(
-            "trajectories.csv:4: state `run` is not walk, pause, landmark or return",
-        ));
+    // `\n`, `\r\n` and classic Mac `\r` endings: the same line 4 (the review found `\r`
+    // files named line 1).
+    for eol in ["\n", "\r\n", "\r"] {
+        fs::write(run.join("trajectories.csv"), lines.join(eol) + eol).unwrap();
+        swarmmap()
+            .arg("report")
+            .arg(&run)
+            .assert()
+            .code(2)
+            .stderr(contains(
+                "trajectories.csv:4: state `run` is not walk, pause, landmark or return",
+            ));
+    }
 }
 
 #[test]

@@ -4,6 +4,7 @@
 //! density joins the method's bank instead of replacing it.
 
 use assert_cmd::Command;
+use predicates::prelude::PredicateBooleanExt;
 use predicates::str::contains;
 use swarmmap::mapping::classify::{Models, SHIPPED};
 
@@ -108,7 +109,10 @@ fn a_bad_model_file_is_an_input_error_naming_it() {
         .arg(&out)
         .assert()
         .code(2)
-        .stderr(contains("is not a model file"));
+        .stderr(contains("not a model file"))
+        // Refused before any training run (found by the fortieth session's review: the file
+        // was read only after them, and the fit lost).
+        .stderr(contains("done").not());
 }
 
 /// Regression: a cap outside [0, 1] was accepted and fitted as if unconstrained.

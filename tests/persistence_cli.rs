@@ -120,31 +120,36 @@ fn bad_files_name_the_line_and_exit_2() {
     bad(
         "0,0\n1,nan\n",
         &[],
-        ":2: coordinate 1 of point 1 is not a finite number (field 2 of the line)",
+        ":2: field 2: coordinate 1 of point 1 is not a finite number",
     );
     // Regression: coordinates this large made every distance overflow to infinity, and
     // the diagram came out with every point an essential class, without a word.
     bad(
         "0,0\n1,0\n3e200,1\n",
         &[],
-        ":3: coordinate 0 of point 2 is 3e200, beyond ±1e150: squared distances would overflow",
+        ":3: field 1: coordinate 0 of point 2 is 3e200, beyond ±1e150: squared distances would overflow",
     );
     bad("", &[], "no rows");
     bad(
         "0,1\n2,0\n",
         &["--distance-matrix"],
-        ":1: entries (0, 1) = 1 and (1, 0) = 2 differ",
+        ":1: field 2: entries (0, 1) = 1 and (1, 0) = 2 differ",
     );
     bad(
         "0,-1\n-1,0\n",
         &["--distance-matrix"],
-        ":1: entry (0, 1) is -1; distances must be finite and non-negative (field 2 of the line)",
+        ":1: field 2: entry (0, 1) is -1; distances must be finite and non-negative",
+    );
+    bad(
+        "0,1\n1,2\n",
+        &["--distance-matrix"],
+        ":2: field 2: diagonal entry (1, 1) is 2",
     );
     // A far entry is echoed with an exponent (found by the fortieth session's review).
     bad(
         "0,-1e200\n-1e200,0\n",
         &["--distance-matrix"],
-        ":1: entry (0, 1) is -1e200;",
+        ":1: field 2: entry (0, 1) is -1e200;",
     );
     bad(
         "0,1,2\n1,0,1\n",

@@ -187,6 +187,20 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
         assert_eq!(points, 60, "{dir:?}");
         assert_eq!(json(&dir.join("maps/connection_1.json"))["cutoff"], 7.5);
     }
+    // The whole section keeps the world's windows (2 of them, overlapping 30 s), which the
+    // defaults (4, 300 s) would not fit in the tiny run (found by the fortieth session's
+    // review).
+    swarmmap()
+        .args([
+            "map",
+            "--set",
+            "mapping=(method: Embedded, rips_points: 60)",
+        ])
+        .arg(&run)
+        .assert()
+        .success();
+    let s = json(&run.join("summary.json"));
+    assert_eq!(s["windows"].as_array().unwrap().len(), 2, "{s}");
     let before = fs::read(log.join("summary.json")).unwrap();
     for (sets, says) in [
         (
@@ -252,7 +266,7 @@ fn map_warns_of_windows_far_sparser_than_the_models_training() {
         sparse.contains("encounters per Rips vertex, far fewer than the 4.39–12.08"),
         "{sparse}"
     );
-    assert!(sparse.contains("mapping.rips_points"), "{sparse}");
+    assert!(sparse.contains("fewer windows"), "{sparse}");
     // 50 points: ≈ 3.6 a vertex, within the margin of the model's least (4.39 / 1.5).
     let fine = map(&["--set", "mapping.rips_points=50"]);
     assert!(!fine.contains("Rips vertex"), "{fine}");
@@ -295,6 +309,48 @@ fn an_empty_window_is_warned_about_and_joins_nothing() {
     assert_eq!(s["connections"][0]["count"], 0, "{s}");
     let c = json(&log.join("maps/connections.json"));
     assert_eq!(c[0]["joins"].as_array().unwrap().len(), 0);
+}
+
+/// Each contact logged twice (by both robots, swapped ids and a later clock) and a static
+/// interval inside another of its agent are warned of (found by the fortieth session's
+/// review: a log doubled this way mapped in silence).
+#[test]
+fn map_warns_of_contacts_logged_twice_and_overlapping_static_intervals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
+    let path = log.join("encounters.csv");
+    let text = fs::read_to_string(&path).unwrap();
+    let mut out = text.clone();
+    for row in text.lines().skip(1).take(5) {
+        let f: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
+        out.push_str(&format!(
+            "{},{},{},{}\n",
+            f[0] + 0.03,
+            f[1] + 0.03,
+            f[3],
+            f[2]
+        ));
+    }
+    fs::write(&path, out).unwrap();
+    let st = log.join("static_intervals.csv");
+    let mut text = fs::read_to_string(&st).unwrap();
+    text.push_str("0,0,5,pause\n0,1,2,pause\n");
+    fs::write(&st, text).unwrap();
+    let run = swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    let stderr = String::from_utf8(run.stderr).unwrap();
+    assert!(
+        stderr.contains("has 5 row(s) overlapping in time an earlier encounter of the same"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("static_intervals.csv has 1 interval(s) overlapping"),
+        "{stderr}"
+    );
 }
 
 /// `--method embedded` on a real log, with and without landmark intervals: every window

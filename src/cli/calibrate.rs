@@ -246,6 +246,13 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             }
         }
     }
+    // The model file the fit joins, read and checked before any training run (a bad one
+    // would otherwise be found only after them, and the fit lost).
+    let existing = if args.out.exists() {
+        Some(Models::load(&args.out).map_err(input)?)
+    } else {
+        None
+    };
     refuse_repeated_worlds(&args.worlds)?;
     let mut paths = args.worlds.clone();
     if paths.is_empty() {
@@ -475,12 +482,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             })
             .collect()
     });
-    let mut models: Models = match std::fs::read_to_string(&args.out) {
-        Ok(text) => serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a model file", args.out.display()))
-            .map_err(input)?,
-        Err(_) => Models::active(),
-    };
+    let mut models: Models = existing.unwrap_or_else(Models::active);
     let mut by_method: Vec<Training> = Vec::new();
     for (target, samples, densities, world, seed) in results
         .into_iter()

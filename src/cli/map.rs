@@ -2,7 +2,7 @@
 //! maps, connections and the global map of an encounter log, from a simulation or a real
 //! experiment. An existing `RUN_DIR/report/` is regenerated from the new maps.
 
-use super::{Failure, input, load_world};
+use super::{Failure, input};
 use clap::Args;
 use std::path::PathBuf;
 use swarmmap::log::EncounterLog;
@@ -111,15 +111,24 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         .time("reading", || EncounterLog::read_dir_noting(&args.run_dir))
         .map_err(input)?;
     let defaults = mapping_sets(args)?;
-    let world = match &args.world {
-        Some(path) => Some(load_world(path, &args.set)?),
-        None => match spec_from_run(&args.run_dir).map_err(input)? {
-            Some(mut spec) => {
-                super::apply_sets(&mut spec, &args.set)?;
-                Some(spec.check().map_err(input)?)
+    let spec = match &args.world {
+        Some(path) => Some(swarmmap::world::WorldSpec::load(path).map_err(input)?),
+        None => spec_from_run(&args.run_dir).map_err(input)?,
+    };
+    let world = match spec {
+        Some(mut spec) => {
+            // The windows stay the world's (or the flags'): a `--set mapping=(...)` of the
+            // whole section would otherwise reset them to the defaults.
+            let cut = spec.mapping.as_ref().map(|m| (m.windows, m.overlap));
+            super::apply_sets(&mut spec, &args.set)?;
+            if let (Some(m), Some((windows, overlap))) = (spec.mapping.as_mut(), cut) {
+                (m.windows, m.overlap) = (windows, overlap);
+            } else if let Some(m) = spec.mapping.as_mut() {
+                (m.windows, m.overlap) = (None, None);
             }
-            None => None,
-        },
+            Some(spec.check().map_err(input)?)
+        }
+        None => None,
     };
     let (mut cfg, stitch) = match &world {
         Some(w) => (

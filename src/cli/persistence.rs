@@ -164,11 +164,13 @@ fn located(file: &Path, rows: &[Row], e: MatrixError) -> anyhow::Error {
         | MatrixError::TooLarge { col, .. }
         | MatrixError::BadEntry { col, .. }
         | MatrixError::Asymmetric { col, .. } => Some(col),
+        MatrixError::Diagonal { row, .. } => Some(row),
         _ => None,
     };
-    let field = col.map_or(String::new(), |c| format!(" (field {} of the line)", c + 1));
+    // As a field that is not a number is named: `FILE:LINE: field N: ...`.
+    let field = col.map_or(String::new(), |c| format!("field {}: ", c + 1));
     match row.and_then(|r| rows.get(r)) {
-        Some((line, _)) => anyhow!("{}:{line}: {e}{field}", file.display()),
+        Some((line, _)) => anyhow!("{}:{line}: {field}{e}", file.display()),
         None => anyhow!("{}: {e}", file.display()),
     }
 }

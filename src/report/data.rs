@@ -315,9 +315,10 @@ fn check_global(path: &Path, g: &GlobalIn) -> Result<(), ReportError> {
 /// Reads `trajectories.csv` (`time,agent,x,y,state`).
 pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
     let file = std::fs::File::open(path).map_err(|e| invalid(path, e.to_string()))?;
+    // Lines numbered from byte offsets, so `\r` and `\r\n` endings count as the file's.
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(file);
+        .from_reader(crate::log::LineIndex::new(file));
     let headers = reader
         .headers()
         .map_err(|e| invalid_line(path, 1, e.to_string()))?;
@@ -339,12 +340,22 @@ pub fn read_trajectories(path: &Path) -> Result<Vec<Sample>, ReportError> {
         ));
     }
     let mut out = Vec::new();
-    for record in reader.records() {
-        let record = record.map_err(|e| {
-            let line = e.position().map_or(0, csv::Position::line);
-            invalid_line(path, line, e.to_string())
-        })?;
-        let line = record.position().map_or(0, csv::Position::line);
+    let mut record = csv::StringRecord::new();
+    loop {
+        let at = reader.position().byte();
+        match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => {
+                let line = reader
+                    .get_ref()
+                    .line_of(e.position().map_or(at, csv::Position::byte));
+                return Err(invalid_line(path, line, e.to_string()));
+            }
+        }
+        let line = reader
+            .get_ref()
+            .line_of(record.position().map_or(at, csv::Position::byte));
         let field = |i: usize| record.get(i).unwrap_or("");
         let num = |i: usize| -> Result<f64, ReportError> {
             field(i)
