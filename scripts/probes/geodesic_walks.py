@@ -16,12 +16,13 @@ space. Those lines form the walk graph on the sites; an agent that walked round 
 from A to B has no thin ellipse across it, so the graph's shortest path from A to B bends
 round the obstacle. Each moving agent's place at time t between its landmark encounters
 (t1, A) and (t2, B) is put at the fraction (t - t1) / (t2 - t1) of that path's length; an
-encounter of two moving agents gets the mean of its agents' places, falling back to the
-shipped place for an agent without a path.
+encounter of two moving agents gets the mean of the places of those of its agents that have
+one, and keeps its shipped place when neither has.
 
 For each window it prints one JSON line: for each placement ("shipped", "straight" (the same
 interpolation on the straight segment: the control), "geodesic", "bent" (the shipped place
-moved by the geodesic place's offset from the straight one) and "geodesic_true" (the sites at
+moved by the mean, over the agents that have both, of each agent's geodesic place minus its
+straight place) and "geodesic_true" (the sites at
 their true places, a ceiling for the sites)), the alpha-complex H1 bars (life over 0.05 m) of
 every mapped encounter, each labelled with the obstacle within 0.35 m of its void. With
 `--score FILE...` it reads the lines back and prints, per placement, the windows the best
@@ -89,25 +90,31 @@ def geodesic_places(events, site_pos, landmark_at, times):
     def straight(a, b, f):
         return None if a == b else pos[a] + (pos[b] - pos[a]) * f
 
-    out = {"geodesic": {}, "straight": {}}
-    for name, place in (("geodesic", along), ("straight", straight)):
-        for i, ev in enumerate(events):
-            if landmark_at[i] is not None:
+    out = {"geodesic": {}, "straight": {}, "offset": {}}
+    for i, ev in enumerate(events):
+        if landmark_at[i] is not None:
+            continue
+        found = {"geodesic": [], "straight": [], "offset": []}
+        for agent in (ev["a"], ev["b"]):
+            lst = visits.get(agent, [])
+            k = bisect.bisect_right(lst, (times[i], math.inf))
+            if k == 0 or k == len(lst):
                 continue
-            got = []
-            for agent in (ev["a"], ev["b"]):
-                lst = visits.get(agent, [])
-                k = bisect.bisect_right(lst, (times[i], math.inf))
-                if k == 0 or k == len(lst):
-                    continue
-                (t1, a), (t2, b) = lst[k - 1], lst[k]
-                if t2 - t1 <= 0:
-                    continue
-                p = place(a, b, (times[i] - t1) / (t2 - t1))
-                if p is not None:
-                    got.append(p)
-            if got:
-                out[name][i] = np.mean(got, 0)
+            (t1, a), (t2, b) = lst[k - 1], lst[k]
+            if t2 - t1 <= 0:
+                continue
+            f = (times[i] - t1) / (t2 - t1)
+            g, st = along(a, b, f), straight(a, b, f)
+            if g is not None:
+                found["geodesic"].append(g)
+            if st is not None:
+                found["straight"].append(st)
+            # The same agent's two places: how far the geodesic moves it.
+            if g is not None and st is not None:
+                found["offset"].append(g - st)
+        for name, places in found.items():
+            if places:
+                out[name][i] = np.mean(places, 0)
     return out
 
 
@@ -137,8 +144,7 @@ def probe(run):
         emb_pos = {s: align(np.mean(emb_site[s], 0)) for s in sites}
         for name, site_pos in (("", emb_pos), ("_true", {s: np.array(true_site[s]) for s in sites})):
             got = geodesic_places(events, site_pos, landmark_at, times)
-            got["bent"] = {i: shipped[i] + p - got["straight"][i]
-                           for i, p in got["geodesic"].items() if i in got["straight"]}
+            got["bent"] = {i: shipped[i] + d for i, d in got.pop("offset").items()}
             for kind, places in got.items():
                 if name and kind != "geodesic":
                     continue
