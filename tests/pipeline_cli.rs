@@ -212,6 +212,10 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
             "pass --windows instead",
         ),
         (
+            &["--set", "mapping.rips_pints=60"][..],
+            "no such mapping setting; map takes mapping.cluster_cutoff,",
+        ),
+        (
             &["--set", "mapping=(overlap: 10)"][..],
             "pass --overlap instead",
         ),

@@ -72,6 +72,21 @@ fn mapping_sets(args: &MapArgs) -> Result<MappingParams, Failure> {
             .split_once('=')
             .map_or(assignment.as_str(), |(p, _)| p);
         let key = super::setting_key(path);
+        if key.starts_with("mapping.") && !swarmmap::world::SETTING_PATHS.contains(&key.as_str()) {
+            let valid: Vec<&str> = swarmmap::world::SETTING_PATHS
+                .iter()
+                .copied()
+                .filter(|p| {
+                    p.starts_with("mapping.")
+                        && !matches!(*p, "mapping.windows" | "mapping.overlap")
+                })
+                .collect();
+            return Err(input(anyhow::anyhow!(
+                "--set {assignment}: no such mapping setting; map takes {} (and the whole \
+                 mapping=(...))",
+                valid.join(", ")
+            )));
+        }
         if key != "mapping" && !key.starts_with("mapping.") {
             return Err(input(anyhow::anyhow!(
                 "--set {assignment}: map takes only mapping.FIELD=VALUE (or the whole \
