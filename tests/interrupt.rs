@@ -234,9 +234,7 @@ fn sigterm_and_sighup_are_handled_like_ctrl_c() {
             .spawn()
             .unwrap();
         std::thread::sleep(std::time::Duration::from_millis(800));
-        let _ = Command::new("kill")
-            .args([&format!("-{signal}"), &child.id().to_string()])
-            .status();
+        kill(signal, child.id());
         let output = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(
@@ -273,16 +271,19 @@ fn a_run_started_under_nohup_ignores_the_hang_up() {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(800));
-    let _ = Command::new("kill")
-        .args(["-HUP", &child.id().to_string()])
-        .status();
+    kill("HUP", child.id());
     std::thread::sleep(std::time::Duration::from_millis(300));
     assert!(
         child.try_wait().unwrap().is_none(),
         "the run stopped on a hang-up it was started to ignore"
     );
-    let _ = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status();
+    kill("TERM", child.id());
     assert_eq!(child.wait().unwrap().code(), Some(130));
+}
+
+/// Sends SIG`signal` to process `pid`.
+fn kill(signal: &str, pid: u32) {
+    let _ = Command::new("kill")
+        .args([&format!("-{signal}"), &pid.to_string()])
+        .status();
 }

@@ -239,6 +239,18 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
     }
 }
 
+/// `swarmmap map --windows 2 --overlap 30 EXTRA LOG`, which must succeed: its stderr.
+fn map_warnings(log: &Path, extra: &[&str]) -> String {
+    let out = swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .args(extra)
+        .arg(log)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    String::from_utf8(out.stderr).unwrap()
+}
+
 /// A window far sparser than the shipped model's training windows is warned about (found
 /// by the fortieth session's review: a tenth of a log's rows gave dozens of false holes in
 /// silence); at a density the model knows, nothing is said.
@@ -247,22 +259,9 @@ fn map_warns_of_windows_far_sparser_than_the_models_training() {
     let tmp = tempfile::tempdir().unwrap();
     let log = real_log(tmp.path());
     let map = |extra: &[&str]| {
-        let out = swarmmap()
-            .args([
-                "map",
-                "--windows",
-                "2",
-                "--overlap",
-                "30",
-                "--method",
-                "embedded",
-            ])
-            .args(extra)
-            .arg(&log)
-            .output()
-            .unwrap();
-        assert!(out.status.success());
-        String::from_utf8(out.stderr).unwrap()
+        let mut args = vec!["--method", "embedded"];
+        args.extend_from_slice(extra);
+        map_warnings(&log, &args)
     };
     // The tiny world's ≈ 180 encounters a window over as many Rips points: ≈ 1.4 a vertex.
     let sparse = map(&[]);
@@ -296,13 +295,7 @@ fn an_empty_window_is_warned_about_and_joins_nothing() {
         .to_string();
     text.push_str(&format!("{first},0,1000000000,landmark\n"));
     fs::write(&path, text).unwrap();
-    let out = swarmmap()
-        .args(["map", "--windows", "2", "--overlap", "30"])
-        .arg(&log)
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let stderr = String::from_utf8(out.stderr).unwrap();
+    let stderr = map_warnings(&log, &[]);
     assert!(
         stderr.contains("window 2 holds no encounter")
             && stderr.contains("but the windows are cut over 0–1e9 s"),
@@ -340,13 +333,7 @@ fn map_warns_of_contacts_logged_twice_and_overlapping_static_intervals() {
     let mut text = fs::read_to_string(&st).unwrap();
     text.push_str("0,0,5,pause\n0,1,2,pause\n");
     fs::write(&st, text).unwrap();
-    let run = swarmmap()
-        .args(["map", "--windows", "2", "--overlap", "30"])
-        .arg(&log)
-        .output()
-        .unwrap();
-    assert!(run.status.success());
-    let stderr = String::from_utf8(run.stderr).unwrap();
+    let stderr = map_warnings(&log, &[]);
     assert!(
         stderr.contains("has 5 row(s) overlapping in time an earlier encounter of the same"),
         "{stderr}"
