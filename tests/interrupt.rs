@@ -7,7 +7,8 @@
 #![cfg(unix)]
 
 use std::collections::BTreeMap;
-use std::os::unix::process::ExitStatusExt;
+use std::os::fd::FromRawFd;
+use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
@@ -286,4 +287,87 @@ fn kill(signal: &str, pid: u32) {
     let _ = Command::new("kill")
         .args([&format!("-{signal}"), &pid.to_string()])
         .status();
+}
+
+#[test]
+fn a_hang_up_of_the_terminal_stops_the_run_cleanly() {
+    // Found by the fortieth session's review: when the terminal hangs up, stderr is gone
+    // (writes fail with EIO) and an `eprintln!` in the handler panicked, so the handler's
+    // thread died before the exit and the run went on with nobody watching. Here the run's
+    // stderr is the slave of a pseudo-terminal that is its controlling terminal; closing the
+    // master hangs it up (SIGHUP, then EIO on every write).
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let (mut master, mut slave) = (-1, -1);
+    // SAFETY: `openpty` fills the two descriptors; null name, termios and window size ask
+    // for the defaults.
+    let opened = unsafe {
+        libc::openpty(
+            &mut master,
+            &mut slave,
+            std::ptr::null_mut(),
+            std::ptr::null(),
+            std::ptr::null(),
+        )
+    };
+    if opened != 0 {
+        eprintln!("no pseudo-terminal on this machine: skipped");
+        return;
+    }
+    // SAFETY: `master` is open. Close-on-exec: a copy of the master inherited by the run
+    // would keep the terminal from hanging up.
+    unsafe {
+        libc::fcntl(master, libc::F_SETFD, libc::FD_CLOEXEC);
+    }
+    // SAFETY: `slave` and `master` are open descriptors this test alone owns.
+    let (slave, master) = unsafe {
+        (
+            std::os::fd::OwnedFd::from_raw_fd(slave),
+            std::os::fd::OwnedFd::from_raw_fd(master),
+        )
+    };
+    let mut command = Command::new(env!("CARGO_BIN_EXE_swarmmap"));
+    command
+        .args(["simulate", "worlds/scenario2.ron", "--quiet", "--out"])
+        .arg(&out)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::from(slave));
+    // SAFETY: only async-signal-safe calls between fork and exec: a new session, then the
+    // pseudo-terminal (now the child's stderr) as its controlling terminal.
+    unsafe {
+        command.pre_exec(|| {
+            if libc::setsid() < 0 || libc::ioctl(2, libc::TIOCSCTTY, 0) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().unwrap();
+    // Our copy of the slave went into the command; drop it so the master's close hangs up.
+    drop(command);
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    drop(master);
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > std::time::Duration::from_secs(20) {
+            let _ = child.kill();
+            panic!("the run went on after its terminal hung up");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    assert_eq!(
+        (status.code(), status.signal()),
+        (Some(130), None),
+        "the hang-up did not stop the run through the handler (0: it went on to the end)"
+    );
+    for rel in files(&out).keys() {
+        assert!(
+            !rel.to_string_lossy().ends_with(".tmp"),
+            "{rel:?} left behind"
+        );
+    }
 }
