@@ -413,6 +413,33 @@ pub struct ReadNotes {
 }
 
 impl EncounterLog {
+    /// The log exactly as its CSV files hold it: every time and position rounded to the
+    /// six decimals the simulator writes (README, "Output files"). The simulator hands out
+    /// only such logs, so a run mapped in memory (`swarmmap run`, `eval`) and the same run
+    /// mapped again from its files (`swarmmap map DIR`) read the same numbers and give the
+    /// same maps; rounding them only in the files moved ties in the metric and changed
+    /// whole windows (found by the forty-first session's review).
+    pub fn as_written(mut self) -> Self {
+        let mut buf = String::new();
+        let mut round = |x: &mut f64| *x = written(*x, &mut buf);
+        for e in &mut self.encounters {
+            round(&mut e.start);
+            round(&mut e.end);
+            if let Some(truth) = &mut e.truth {
+                truth.iter_mut().for_each(&mut round);
+            }
+        }
+        for iv in &mut self.static_intervals {
+            round(&mut iv.start);
+            round(&mut iv.end);
+        }
+        for (t, x) in &mut self.leader {
+            round(t);
+            round(x);
+        }
+        self
+    }
+
     /// Reads a log directory: `encounters.csv` (required), `static_intervals.csv`
     /// (optional: without it no time is bridged by static agents) and `leader.csv`
     /// (optional). Truth columns `a_x,a_y,b_x,b_y` are read when all four are present.
@@ -627,6 +654,15 @@ fn read_leader(path: &Path) -> Result<Vec<(f64, f64)>, LogError> {
     let mut out: Vec<(f64, f64)> = rows.into_iter().map(|(t, x, _)| (t, x)).collect();
     out.dedup();
     Ok(out)
+}
+
+/// `x` as the log files write it (`{:.6}`) and read it back: the same `f64` a reader of
+/// the file gets.
+pub(crate) fn written(x: f64, buf: &mut String) -> f64 {
+    use std::fmt::Write as _;
+    buf.clear();
+    let _ = write!(buf, "{x:.6}");
+    buf.parse().unwrap_or(x)
 }
 
 #[cfg(test)]

@@ -74,6 +74,50 @@ fn run_writes_every_output_and_is_deterministic() {
     assert_eq!(summary_without_timings(&a), summary_without_timings(&b));
 }
 
+/// Regression (forty-first session's review): `run` mapped the simulator's unrounded log
+/// while its files hold six decimals, so `map DIR` of the same run gave other maps (tiny:
+/// every window's file and the connection differed; a larger world changed its Betti
+/// numbers). The simulator now hands out the log as written.
+#[test]
+fn mapping_a_run_again_from_its_files_gives_its_maps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--no-report", "--quiet", "--out"])
+        .arg(&dir)
+        .assert()
+        .success();
+    let maps = |dir: &Path| -> Vec<(String, Vec<u8>)> {
+        let mut v: Vec<_> = fs::read_dir(dir.join("maps"))
+            .unwrap()
+            .map(|e| {
+                let p = e.unwrap().path();
+                (
+                    p.file_name().unwrap().to_string_lossy().into_owned(),
+                    fs::read(&p).unwrap(),
+                )
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let (before, summary) = (maps(&dir), summary_without_timings(&dir));
+    assert!(
+        before.len() >= 4,
+        "{:?}",
+        before.iter().map(|m| &m.0).collect::<Vec<_>>()
+    );
+    swarmmap().arg("map").arg(&dir).assert().success();
+    for ((name, a), (_, b)) in before.iter().zip(&maps(&dir)) {
+        assert!(
+            a == b,
+            "maps/{name} differs when the run is mapped from its files"
+        );
+    }
+    assert_eq!(maps(&dir).len(), before.len());
+    assert_eq!(summary_without_timings(&dir), summary);
+}
+
 /// Regression: `map` on a run made with `--seed 3` wrote `"seed": 1` into summary.json (the
 /// world file's own `seed` field, from meta.json's copy of the world) instead of the run's.
 #[test]

@@ -825,14 +825,13 @@ impl Run<'_> {
     /// The log's prefix up to the cut `c` ([`SimOptions::with_prefixes`]); static
     /// intervals still running end at `cut_off`.
     fn prefix(&self, c: f64, cut_off: f64) -> EncounterLog {
-        let mut encounters: Vec<Encounter> = self
+        let encounters: Vec<Encounter> = self
             .log
             .encounters
             .iter()
             .filter(|e| e.start <= c)
             .cloned()
             .collect();
-        encounters.sort_by(encounter_order);
         let mut static_intervals = self.log.static_intervals.clone();
         for (i, a) in self.agents.iter().enumerate() {
             let reason = match a.state {
@@ -847,12 +846,16 @@ impl Run<'_> {
                 reason,
             });
         }
-        static_intervals.sort_by(static_order);
-        EncounterLog {
+        // As the files will hold it, then in the files' order.
+        let mut log = EncounterLog {
             encounters,
             static_intervals,
             leader: self.log.leader.clone(),
         }
+        .as_written();
+        log.encounters.sort_by(encounter_order);
+        log.static_intervals.sort_by(static_order);
+        log
     }
 }
 
@@ -1001,7 +1004,8 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
             _ => {}
         }
     }
-    let mut log = run.log;
+    // Rounded as the files write it before sorting, so the order is the files' order too.
+    let mut log = run.log.as_written();
     log.encounters.sort_by(encounter_order);
     log.static_intervals.sort_by(static_order);
     if let Some(report) = opts.progress {
@@ -1020,7 +1024,16 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         dt,
         leader_interval: leader_every as f64 * dt,
         log,
-        trajectories: traj,
+        // Rounded like the log, as `trajectories.csv` holds them.
+        trajectories: traj.map(|mut traj| {
+            let mut buf = String::new();
+            for p in &mut traj.samples {
+                for x in [&mut p.time, &mut p.x, &mut p.y] {
+                    *x = crate::log::written(*x, &mut buf);
+                }
+            }
+            traj
+        }),
         stats,
     })
 }
