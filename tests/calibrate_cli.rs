@@ -135,6 +135,36 @@ fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
     assert!(!out.exists(), "nothing is fitted or written");
 }
 
+/// Found by the forty-first session's review: `--landscape` naming the `--out` file wrote
+/// the model over the landscape and said both were written; `--set seed=N` was accepted and
+/// recorded in the model's `fitted_on`, though `--seeds` decides every run's seed.
+#[test]
+fn calibrate_refuses_one_file_for_two_outputs_and_a_seed_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("model.json");
+    let same = dir.path().join(".").join("model.json");
+    for (extra, said) in [
+        (
+            vec!["--landscape".to_string(), same.display().to_string()],
+            "is the --out model file too",
+        ),
+        (
+            vec!["--set".to_string(), "seed=5".to_string()],
+            "each run's seed comes from --seeds",
+        ),
+    ] {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .args(["calibrate", WORLD, "--seeds", "1", "--out"])
+            .arg(&out)
+            .args(&extra)
+            .assert()
+            .code(2)
+            .stderr(contains(said));
+    }
+    assert!(!out.exists(), "nothing is fitted or written");
+}
+
 /// `--stability` needs the stabilities: a run that turns them off is refused, not fitted
 /// with a test that never bites, whether the `--set` names the field or the whole section.
 #[test]

@@ -118,6 +118,42 @@ fn mapping_a_run_again_from_its_files_gives_its_maps() {
     assert_eq!(summary_without_timings(&dir), summary);
 }
 
+/// Found by the forty-first session's review: `--seed 5 --set seed=6` ran seed 5 while
+/// meta.json recorded a world of seed 6, and `eval --set seed=5,6` ran the same runs twice
+/// as two parameter sets. Both are refused before any work; `--set seed` alone is a seed.
+#[test]
+fn the_seed_is_given_one_way() {
+    let tmp = tempfile::tempdir().unwrap();
+    for cmd in ["run", "simulate"] {
+        let out = tmp.path().join(cmd);
+        swarmmap()
+            .args([
+                cmd, TINY, "--quiet", "--seed", "5", "--set", "seed=6", "--out",
+            ])
+            .arg(&out)
+            .assert()
+            .code(2)
+            .stderr(contains("both --seed 5 and --set seed=6"));
+        assert!(!out.exists(), "{cmd} made its output");
+    }
+    let out = tmp.path().join("eval");
+    swarmmap()
+        .args([
+            "eval", TINY, "--seeds", "1", "--set", "seed=5,6", "--quiet", "--out",
+        ])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains("each run's seed comes from --seeds"));
+    let out = tmp.path().join("set");
+    swarmmap()
+        .args(["simulate", TINY, "--quiet", "--set", "seed=3", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    assert_eq!(json(&out.join("meta.json"))["seed"], 3);
+}
+
 /// Regression: `map` on a run made with `--seed 3` wrote `"seed": 1` into summary.json (the
 /// world file's own `seed` field, from meta.json's copy of the world) instead of the run's.
 #[test]
@@ -527,6 +563,48 @@ fn a_log_with_absurd_times_is_rejected_not_mapped() {
             "encounters.csv:2: column `end` is `1e195`, beyond ±1e12 s",
         ))
         .stderr(contains("panicked").not());
+}
+
+/// Found by the forty-first session's review: two world files of one name were merged
+/// into one row of the table (their seeds paired as one world's), and a name with a comma
+/// or a quote broke the rows of `eval.csv` and `summary.csv`.
+#[test]
+fn eval_refuses_two_worlds_of_one_name_and_quotes_names_in_its_csv() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tiny = fs::read_to_string(TINY).unwrap();
+    let other = tmp.path().join("other.ron");
+    fs::write(&other, tiny.replace("agents: 40", "agents: 30")).unwrap();
+    let out = tmp.path().join("same");
+    swarmmap()
+        .args(["eval", TINY])
+        .arg(&other)
+        .args(["--seeds", "1", "--quiet", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(contains("are both named `tiny`"));
+    let odd = tmp.path().join("odd.ron");
+    fs::write(
+        &odd,
+        tiny.replace("name: \"tiny\"", r#"name: "tiny, \"v2\"""#),
+    )
+    .unwrap();
+    let out = tmp.path().join("odd");
+    swarmmap()
+        .arg("eval")
+        .arg(&odd)
+        .args(["--seeds", "1", "--quiet", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    for file in ["eval.csv", "summary.csv"] {
+        let mut reader = csv::Reader::from_path(out.join(file)).unwrap();
+        let header = reader.headers().unwrap().len();
+        let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+        assert_eq!(rows.len(), 1, "{file}");
+        assert_eq!(rows[0].len(), header, "{file}: {:?}", rows[0]);
+        assert_eq!(&rows[0][0], r#"tiny, "v2""#, "{file}");
+    }
 }
 
 #[test]

@@ -202,8 +202,24 @@ impl CvGroups {
     }
 }
 
+/// Whether `a` and `b` name one file: the same path, or (both existing, or in the same
+/// existing directory) the same place once links and `..` are resolved.
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    let place = |p: &std::path::Path| {
+        std::fs::canonicalize(p).ok().or_else(|| {
+            let dir = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => std::path::Path::new("."),
+            };
+            Some(std::fs::canonicalize(dir).ok()?.join(p.file_name()?))
+        })
+    };
+    a == b || matches!((place(a), place(b)), (Some(x), Some(y)) if x == y)
+}
+
 pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     let seeds = super::eval::parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
+    super::refuse_seed_set(&args.set)?;
     if !(0.0..=1.0).contains(&args.max_false_holes) {
         return Err(input(anyhow!(
             "--max-false-holes is {}; it is a share of the hole-free training windows, from 0 to 1 (1 = unconstrained)",
@@ -211,6 +227,15 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
         )));
     }
     // Found before the training runs, not after them.
+    if let Some(landscape) = &args.landscape
+        && same_file(landscape, &args.out)
+    {
+        return Err(input(anyhow!(
+            "--landscape {} is the --out model file too, so one would overwrite the other; give \
+             the landscape its own file, e.g. landscape.csv",
+            landscape.display()
+        )));
+    }
     for (flag, path) in [
         ("--out", Some(&args.out)),
         ("--landscape", args.landscape.as_ref()),

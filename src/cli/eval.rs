@@ -39,6 +39,41 @@ pub struct EvalArgs {
     pub reuse_any_build: bool,
 }
 
+/// The values of `--set PATH=V1,V2,...`: split at the commas outside brackets and quotes,
+/// so that a value may itself be a section or a list (`swarm=(agents: 10, speed: 0.1)`,
+/// `obstacles=[Circle(...), Rect(...)]`).
+fn sweep_values(values: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let (mut depth, mut quoted, mut escaped) = (0usize, false, false);
+    let mut current = String::new();
+    for c in values.chars() {
+        if quoted {
+            quoted = escaped || c != '"';
+            escaped = !escaped && c == '\\';
+        } else {
+            match c {
+                '"' => quoted = true,
+                '(' | '[' | '{' => depth += 1,
+                ')' | ']' | '}' => depth = depth.saturating_sub(1),
+                ',' if depth == 0 => {
+                    out.push(current.trim().to_string());
+                    current.clear();
+                    continue;
+                }
+                _ => {}
+            }
+        }
+        current.push(c);
+    }
+    out.push(current.trim().to_string());
+    out
+}
+
+/// Most seeds one campaign or fit takes: far beyond any campaign this machine could run
+/// (a million runs of the smallest bundled world take weeks), and a bound on the memory a
+/// typo such as `1..18446744073709551615` would otherwise ask for.
+pub const MAX_SEEDS: u64 = 1_000_000;
+
 /// Parses `A..B` (inclusive) or `a,b,c`. A seed listed twice is refused: each seed is one
 /// independent run, and a repeated one would be counted twice in every figure and interval.
 pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
@@ -53,6 +88,13 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
         );
         if a > b {
             return Err(format!("--seeds {s}: the range is empty (start after end)"));
+        }
+        if b - a >= MAX_SEEDS {
+            return Err(format!(
+                "--seeds {s} asks for {} runs of each world; at most {MAX_SEEDS} seeds per \
+                 campaign, so split it into several (each resumes in its own --out)",
+                u128::from(b - a) + 1
+            ));
         }
         Ok((a..=b).collect())
     } else {
@@ -73,6 +115,7 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
 pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     let seeds = parse_seeds(&args.seeds).map_err(|e| input(anyhow!(e)))?;
     super::refuse_repeated_worlds(&args.worlds)?;
+    super::refuse_seed_set(&args.set)?;
     // Before any run: a campaign directory that cannot be written is the user's to fix.
     swarmmap::sim::prepare_out_dir(&args.out).map_err(input)?;
     let mut sweeps: Vec<(String, Vec<String>)> = Vec::new();
@@ -82,7 +125,7 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
                 "--set `{s}`: expected PATH=VALUE[,VALUE...], e.g. swarm.agents=100,200"
             ))
         })?;
-        let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
+        let values = sweep_values(values);
         let path = path.trim().to_string();
         // A repeated value or field would run the same parameters twice and count them
         // as two sets (or let the last one win unseen).
@@ -113,13 +156,27 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     }
     let combos = combinations(&sweeps);
     // Validate every world × combination up front, so a typo fails at once, not per run.
+    // Runs are grouped by the world's name: two files of one name would be merged into one
+    // row, their seeds paired as one world's.
+    let mut names: std::collections::BTreeMap<String, &std::path::PathBuf> = Default::default();
     for w in &args.worlds {
         for c in &combos {
             let mut spec = WorldSpec::load(w).map_err(input)?;
             for (p, v) in c {
                 swarmmap::world::apply_override(&mut spec, p, v).map_err(input)?;
             }
-            spec.check().map_err(input)?;
+            let world = spec.check().map_err(input)?;
+            if let Some(first) = names.insert(world.name.clone(), w)
+                && first != w
+            {
+                return Err(input(anyhow!(
+                    "{} and {} are both named `{}`, so the campaign would count their runs as \
+                     one world's; give each world its own `name`",
+                    first.display(),
+                    w.display(),
+                    world.name
+                )));
+            }
         }
     }
     let mut jobs = Vec::new();
@@ -183,6 +240,27 @@ mod tests {
         assert_eq!(parse_seeds("4,7").unwrap(), vec![4, 7]);
         assert!(parse_seeds("3..1").is_err());
         assert!(parse_seeds("x").is_err());
+        // A sweep's values are split at the commas between values only (found by review:
+        // `obstacles=[...]` or a whole section could not be given to eval).
+        assert_eq!(super::sweep_values("100, 200"), ["100", "200"]);
+        assert_eq!(
+            super::sweep_values("(agents: 10, speed: 0.1),(agents: 20)"),
+            ["(agents: 10, speed: 0.1)", "(agents: 20)"]
+        );
+        assert_eq!(
+            super::sweep_values("[Circle(center: (1.0, 2.0), radius: 0.5)], []"),
+            ["[Circle(center: (1.0, 2.0), radius: 0.5)]", "[]"]
+        );
+        assert_eq!(
+            super::sweep_values(r#""a, \"b\", c",d"#),
+            [r#""a, \"b\", c""#, "d"]
+        );
+        // A range too large to hold is refused, not a panic (found by review: capacity
+        // overflow, status 101).
+        let huge = parse_seeds("1..18446744073709551615").unwrap_err();
+        assert!(huge.contains("18446744073709551615 runs"), "{huge}");
+        assert!(parse_seeds("0..999999").is_ok_and(|s| s.len() == 1_000_000));
+        assert!(parse_seeds("0..1000000").is_err());
         let twice = parse_seeds("1,2,1").unwrap_err();
         assert!(twice.contains("seed 1 is listed twice"), "{twice}");
     }

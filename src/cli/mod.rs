@@ -67,6 +67,38 @@ pub fn reusable_build(reuse_any_build: bool) -> Result<Option<&'static str>, Fai
     })
 }
 
+/// The first `--set` that sets the world's `seed`.
+fn seed_set(sets: &[String]) -> Option<&String> {
+    sets.iter().find(|s| {
+        s.split_once('=')
+            .is_some_and(|(p, _)| setting_key(p) == "seed")
+    })
+}
+
+/// The seed of a single run (`simulate`, `run`): `--seed`, else the world's `seed` (which
+/// `--set seed=N` may change). Both `--seed` and `--set seed` are refused: the run would
+/// use one and `meta.json` record the other in its world.
+pub fn run_seed(flag: Option<u64>, sets: &[String]) -> Result<Option<u64>, Failure> {
+    match (flag, seed_set(sets)) {
+        (Some(n), Some(set)) => Err(input(anyhow::anyhow!(
+            "both --seed {n} and --set {set} give the run's seed, so one would be lost; give one"
+        ))),
+        _ => Ok(flag),
+    }
+}
+
+/// Refuses `--set seed=N` in `eval` and `calibrate`, whose runs take their seeds from
+/// `--seeds`: the set would be ignored, and a sweep of it would count identical runs as
+/// different parameter sets.
+pub fn refuse_seed_set(sets: &[String]) -> Result<(), Failure> {
+    match seed_set(sets) {
+        Some(set) => Err(input(anyhow::anyhow!(
+            "--set {set}: each run's seed comes from --seeds, which replaces the world's; give              the seeds as --seeds (a range A..B or a list like 1,2,5)"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Loads a world file and applies `--set PATH=VALUE` overrides; any problem is an input
 /// error (status 2).
 pub fn load_world(

@@ -37,8 +37,9 @@ pub struct RunArgs {
 }
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
+    let flag = super::run_seed(args.seed, &args.set)?;
     let world = load_world(&args.world, &args.set)?;
-    let seed = args.seed.unwrap_or(world.seed);
+    let seed = flag.unwrap_or(world.seed);
     let out = args
         .out
         .clone()

@@ -31,8 +31,9 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: &SimulateArgs) -> Result<(), Failure> {
+    let flag = super::run_seed(args.seed, &args.set)?;
     let world = load_world(&args.world, &args.set)?;
-    let seed = args.seed.unwrap_or(world.seed);
+    let seed = flag.unwrap_or(world.seed);
     // Before the simulation, which may take hours: an output it cannot write is the
     // user's to fix, and said now.
     prepare_out_dir(&args.out).map_err(input)?;

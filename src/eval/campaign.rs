@@ -142,6 +142,8 @@ pub struct RunRecord {
 
 fn run_one(job: &Job, text: &str) -> RunRecord {
     let name = job.world.display().to_string();
+    // The world's name labels the run, failed or not, as soon as the world is known.
+    let mut label = None;
     let result = (|| -> Result<Summary, String> {
         let mut spec = crate::world::parse_str(text, &name).map_err(|e| e.to_string())?;
         for (p, v) in &job.overrides {
@@ -149,6 +151,7 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
         }
         apply_override(&mut spec, "seed", &job.seed.to_string()).map_err(|e| e.to_string())?;
         let world = WorldSpec::check(spec).map_err(|e| e.to_string())?;
+        label = Some(world.name.clone());
         let opts = RunOptions {
             seed: job.seed,
             out: None,
@@ -159,12 +162,13 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
         let (_, mapped) = run_world(&world, &opts).map_err(|e| e.to_string())?;
         Ok(mapped.summary)
     })();
-    let world = job
-        .world
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("world")
-        .to_string();
+    let world = label.unwrap_or_else(|| {
+        job.world
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("world")
+            .to_string()
+    });
     match result {
         Ok(s) => RunRecord {
             world: s.world.clone(),
@@ -376,7 +380,7 @@ pub fn csv(records: &[RunRecord]) -> String {
         let s = r.summary.as_ref().map(score).unwrap_or_default();
         out.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{}\n",
-            r.world,
+            quote(&r.world),
             quote(&r.params),
             r.seed,
             s.windows,
@@ -731,7 +735,7 @@ pub fn summary_csv(groups: &[Group]) -> String {
             });
         out.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3}\n",
-            g.world,
+            quote(&g.world),
             quote(&g.params),
             g.runs,
             g.failed,
