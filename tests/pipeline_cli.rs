@@ -154,6 +154,29 @@ fn the_seed_is_given_one_way() {
     assert_eq!(json(&out.join("meta.json"))["seed"], 3);
 }
 
+/// Found by the forty-first session's review: `run` said nothing of what `map` warns of in
+/// the same run's log. Each warning names the world settings that change it.
+#[test]
+fn run_warns_of_what_map_would() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (set, said) in [
+        ("swarm.landmark_fraction=0", "no agent became a landmark"),
+        ("swarm.agents=1", "a single agent meets no one"),
+        (
+            "swarm.agents=3",
+            "every window's encounters were judged noise",
+        ),
+    ] {
+        let out = tmp.path().join(set);
+        swarmmap()
+            .args(["run", TINY, "--no-report", "--quiet", "--set", set, "--out"])
+            .arg(&out)
+            .assert()
+            .success()
+            .stderr(contains(format!("warning: {said}")));
+    }
+}
+
 /// Regression: `map` on a run made with `--seed 3` wrote `"seed": 1` into summary.json (the
 /// world file's own `seed` field, from meta.json's copy of the world) instead of the run's.
 #[test]

@@ -71,18 +71,22 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let (_, mapped) = result.map_err(|e| {
+    let (sim, mapped) = result.map_err(|e| {
         if e.is_input() {
             input(e)
         } else {
             Failure::Other(e.into())
         }
     })?;
+    let log = sim.log;
     print!("{}", mapped.summary.table());
     let bank = swarmmap::mapping::pipeline::MapConfig::for_world(&world)
         .local
         .classifier;
     if let Some(w) = swarmmap::pipeline::density_warning(&mapped.maps, &bank) {
+        eprintln!("warning: {w}");
+    }
+    for w in run_warnings(&world, &log, &mapped) {
         eprintln!("warning: {w}");
     }
     println!("outputs: {}", out.display());
@@ -91,6 +95,72 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         println!("{}", super::report::describe(&written));
     }
     Ok(())
+}
+
+/// What `map` would warn of in a log, said of a simulated run in terms of its world's
+/// settings (found by review: `run` kept silent about a run without encounters, without
+/// landmarks, with empty windows or with every window judged noise).
+fn run_warnings(
+    world: &swarmmap::world::World,
+    log: &swarmmap::log::EncounterLog,
+    mapped: &swarmmap::pipeline::Mapped,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if log.encounters.is_empty() && world.swarm.agents < 2 {
+        out.push(
+            "a single agent meets no one, so the run recorded no encounters and every map is \
+             empty; give swarm.agents at least 2"
+                .to_string(),
+        );
+        return out;
+    }
+    if log.encounters.is_empty() {
+        out.push(format!(
+            "the run recorded no encounters, so every map is empty: {} agents with a \
+             detection radius of {} m never came within it of each other; more agents \
+             (swarm.agents) or a larger radius (swarm.detection_radius) record some",
+            world.swarm.agents,
+            swarmmap::world::given(world.swarm.detection_radius)
+        ));
+        return out;
+    }
+    if !log
+        .static_intervals
+        .iter()
+        .any(|s| s.reason == swarmmap::log::StaticReason::Landmark)
+    {
+        out.push(
+            "no agent became a landmark (round(swarm.landmark_fraction × the agents inside D(t)) \
+             stayed 0): \
+             no static agent bridges time or stands through the windows' overlaps, so the \
+             metric is travel time alone and consecutive local maps cannot be stitched; raise \
+             swarm.landmark_fraction or swarm.agents"
+                .to_string(),
+        );
+    }
+    let empty: Vec<String> = mapped
+        .maps
+        .iter()
+        .filter(|m| m.events.is_empty())
+        .map(|m| m.index.to_string())
+        .collect();
+    if !empty.is_empty() {
+        out.push(format!(
+            "window(s) {} of {} hold no encounter: the run records too few for its windows; \
+             fewer windows (mapping.windows) or more agents (swarm.agents)",
+            empty.join(", "),
+            mapped.maps.len()
+        ));
+    } else if mapped.summary.global.betti[0] == 0 {
+        out.push(format!(
+            "every window's encounters were judged noise (β0 = 0 everywhere) although the run \
+             recorded {} encounter(s): too few for {} window(s); fewer windows \
+             (mapping.windows) or more agents (swarm.agents)",
+            log.encounters.len(),
+            mapped.maps.len()
+        ));
+    }
+    out
 }
 
 /// `name` as one path component: characters other than letters, digits, `-`, `_` and `.`
