@@ -167,6 +167,31 @@ pub fn world_from_run(dir: &Path) -> Result<Option<World>, PipelineError> {
     }
 }
 
+/// The world a run's maps were judged against: `summary.json`'s `judged_world` when
+/// `swarmmap map --world FILE` gave one (`summary_path` names the file in errors), else
+/// the world in `meta.json` ([`world_from_run`]).
+pub fn judged_world(
+    dir: &Path,
+    judged: Option<&serde_json::Value>,
+    summary_path: &Path,
+) -> Result<Option<World>, PipelineError> {
+    let Some(value) = judged else {
+        return world_from_run(dir);
+    };
+    let mut spec: WorldSpec =
+        serde_path_to_error::deserialize(value.clone()).map_err(|e| PipelineError::Meta {
+            path: summary_path.to_path_buf(),
+            message: format!(
+                "its `judged_world` is not a valid world: judged_world.{}: {}; map the run \
+                 again",
+                e.path(),
+                e.inner()
+            ),
+        })?;
+    spec.origin.name = format!("{} (judged_world)", summary_path.display());
+    Ok(Some(spec.check()?))
+}
+
 /// The world spec a run's `meta.json` records, before its check (to take `--set`
 /// overrides first, as `swarmmap map --set` does); `None` without a `meta.json`.
 pub fn spec_from_run(dir: &Path) -> Result<Option<WorldSpec>, PipelineError> {
@@ -367,6 +392,7 @@ fn finish(
         },
         timings: timings.0.clone(),
         alongside: BTreeMap::new(),
+        judged_world: None,
     };
     Ok(Mapped {
         maps,

@@ -272,6 +272,45 @@ fn remapping_refreshes_an_existing_report() {
     );
 }
 
+/// Found by the forty-first session's review: after `map --world OTHER` the summary judged
+/// the maps against OTHER while the report drew the run's own world from meta.json. The
+/// summary now records the world it was judged against, and the report draws it.
+#[test]
+fn a_report_draws_the_world_the_maps_were_judged_against() {
+    let (tmp, dir) = fixture_copy();
+    swarmmap().arg("report").arg(&dir).assert().success();
+    let own = fs::read(dir.join("report/environment.svg")).unwrap();
+    let moved = tmp.path().join("moved.ron");
+    let tiny = fs::read_to_string("tests/fixtures/worlds/tiny.ron").unwrap();
+    assert!(tiny.contains("center: (3.0, 2.0)"));
+    fs::write(
+        &moved,
+        tiny.replace("center: (3.0, 2.0)", "center: (4.5, 2.0)"),
+    )
+    .unwrap();
+    swarmmap()
+        .args(["map", "--world"])
+        .arg(&moved)
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("report refreshed"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["judged_world"]["obstacles"][0]["Circle"]["center"],
+        serde_json::json!([4.5, 2.0])
+    );
+    let other = fs::read(dir.join("report/environment.svg")).unwrap();
+    assert!(other != own, "the report still draws the run's own world");
+    // Made again from the files alone, the report draws the same world.
+    swarmmap().arg("report").arg(&dir).assert().success();
+    assert!(fs::read(dir.join("report/environment.svg")).unwrap() == other);
+    // Mapped again with the run's own world, it draws that one again.
+    swarmmap().arg("map").arg(&dir).assert().success();
+    assert!(fs::read(dir.join("report/environment.svg")).unwrap() == own);
+}
+
 /// A report interrupted before its page was written (figures, no `index.html`) is made
 /// again by the next `map`, not dropped (found by the fortieth session's review: only a
 /// report with its page counted as existing, and the stale figures were just deleted).

@@ -301,13 +301,20 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         Some(path) => path.clone(),
         None => args.run_dir.join("meta.json"),
     };
-    let mapped = map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(|e| {
-        if matches!(e, PipelineError::Truth(_)) {
-            input(anyhow::anyhow!("{}: the world's {e}", world_file.display()))
-        } else {
-            input(e)
-        }
-    })?;
+    let mut mapped =
+        map_log(&log, world.as_ref(), &cfg, &stitch, seed, &mut timings).map_err(|e| {
+            if matches!(e, PipelineError::Truth(_)) {
+                input(anyhow::anyhow!("{}: the world's {e}", world_file.display()))
+            } else {
+                input(e)
+            }
+        })?;
+    // A world given with --world is recorded, so the report draws the world the maps were
+    // judged against, not meta.json's (found by review: it drew the run's world under the
+    // other world's truth).
+    if args.world.is_some() {
+        mapped.summary.judged_world = world.as_ref().map(swarmmap::sim::world_json);
+    }
     // A report made from the previous maps would be stale: it goes before they are
     // replaced (an interrupted or failed write then leaves no report of other maps, nor
     // the figures of a report interrupted earlier) and, if there was one, is made again

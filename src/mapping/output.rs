@@ -88,6 +88,10 @@ pub struct Summary {
     /// (`swarmmap run`; not part of `timings`' total).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub alongside: BTreeMap<String, f64>,
+    /// The world the maps were judged against when it is not the one in `meta.json`
+    /// (`swarmmap map --world FILE`), as `meta.json` writes a world: the report draws it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub judged_world: Option<serde_json::Value>,
 }
 
 /// An event of a window as written in `window_<i>.json`.
@@ -479,6 +483,7 @@ mod tests {
             },
             timings: BTreeMap::from([("mapping".to_string(), 1.0)]),
             alongside: BTreeMap::new(),
+            judged_world: None,
         };
         let t = summary.table();
         let holes: Vec<&str> = t

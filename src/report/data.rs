@@ -6,7 +6,7 @@ use super::ReportError;
 use crate::log::EncounterLog;
 use crate::mapping::classify::Classifier;
 use crate::mapping::output::Summary;
-use crate::pipeline::world_from_run;
+use crate::pipeline::judged_world;
 use crate::world::World;
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
@@ -147,7 +147,8 @@ pub struct Sample {
 #[derive(Debug, Clone)]
 pub struct RunData {
     pub dir: PathBuf,
-    /// The world from `meta.json` (none for a log without metadata).
+    /// The world the maps were judged against: `summary.json`'s `judged_world` (`map
+    /// --world`), else the one in `meta.json` (none for a log without metadata).
     pub world: Option<World>,
     pub summary: Summary,
     /// One per summary window, in order.
@@ -482,7 +483,7 @@ pub fn load_run(dir: &Path) -> Result<RunData, ReportError> {
             ));
         }
     }
-    let world = world_from_run(dir)?;
+    let world = judged_world(dir, summary.judged_world.as_ref(), &summary_path)?;
     let traj_path = dir.join("trajectories.csv");
     let trajectories = if traj_path.exists() {
         Some(read_trajectories(&traj_path)?)
