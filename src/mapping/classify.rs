@@ -633,7 +633,9 @@ impl Classifier {
                         && f.birth > 0.0
                         && f.death / f.birth >= self.h1_ratio
                         && f.death - f.birth >= self.h1_span * sigma
-                        || f.birth == 0.0 && f.death > self.h1_span * sigma)
+                        // Born at 0 (coinciding points), the ratio is infinite: the life
+                        // decides, at the same bound as above.
+                        || f.birth == 0.0 && f.death >= self.h1_span * sigma)
             }
             _ => false,
         }
@@ -684,6 +686,22 @@ mod tests {
             .map(|x| f(x.dim, 37.0 * x.birth, 37.0 * x.death))
             .collect();
         assert_eq!(c.betti(&scaled), [2, 1]);
+    }
+
+    /// A bar born at 0 is judged by its life alone, with the bound the other bars meet
+    /// (`≥`; found by the forty-first session's review: it was `>`).
+    #[test]
+    fn a_bar_born_at_zero_is_judged_by_its_life() {
+        let c = Classifier {
+            h0_ratio: 5.0,
+            h1_ratio: 2.0,
+            h1_span: 3.0,
+            h1_crossing: None,
+            h1_stability: None,
+        };
+        assert!(c.robust(&f(1, 0.0, 6.0), 2.0));
+        assert!(c.robust(&f(1, 3.0, 9.0), 2.0));
+        assert!(!c.robust(&f(1, 0.0, 5.9), 2.0));
     }
 
     #[test]

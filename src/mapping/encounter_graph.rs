@@ -4,6 +4,13 @@
 //! The paper's graph has one vertex per encounter E_i and, for every pair sharing an agent,
 //! an edge of weight `w_ij = inf |t1 − t2|` over their time intervals, set to `0` when the
 //! shared agent `s` was static during an interval T^k(s) that meets both T(E_i) and T(E_j).
+//! (The paper writes the condition as T(E_i) ∩ T(E_j) ∩ T^k(s) ≠ ∅, one instant common to
+//! all three; read literally it changes nothing, since two overlapping encounters already
+//! weigh 0. Its intent, an agent standing still between two encounters keeps them at one
+//! place, is what "meets both" builds: E_i = [0, 1] and E_j = [5, 6] of an agent static
+//! through [0, 10] weigh 0 here and 4 by the literal formula. Under `Bridging::Paper` the
+//! static intervals that bridge are the landmarks'; random stops (`pause`) do not, as
+//! [`super::local`] passes them.)
 //! Built literally that is a clique per agent: O(E²) edges.
 //!
 //! # The sparse graph, and why it has the same shortest paths

@@ -2,8 +2,8 @@
 //! the encounter point cloud of its domain and its robust components and holes.
 //!
 //! Per window W_i:
-//! 1. the encounters whose interval meets W_i, and the static intervals meeting it; an
-//!    with `mapping.after_landmarks`, an encounter that ends before the log's first
+//! 1. the encounters whose interval meets W_i, and the static intervals meeting it; with
+//!    `mapping.after_landmarks`, an encounter that ends before the log's first
 //!    landmark interval begins is left out ([`first_landmark_start`]): the paper records
 //!    encounters once the landmarks are selected (§"Exploration and Event Collection"),
 //!    and before any landmark nothing anchors the metric;
@@ -386,7 +386,13 @@ pub fn local_map_with(
         } else {
             members.clone()
         };
-        let sub = subsample_with(&graph, &candidates, &p.subsample, lookahead);
+        let mut sub = subsample_with(&graph, &candidates, &p.subsample, lookahead);
+        if sub.picks.len() < 3 && candidates.len() < members.len() {
+            // The landmark encounters stand at fewer than three places (one landmark
+            // interval: they are one point of the metric), too few to span a plane: the
+            // component is embedded from all its encounters, as without landmarks.
+            sub = subsample_with(&graph, &members, &p.subsample, lookahead);
+        }
         // Embed every member of the component from the representatives' rows.
         let rows: Vec<Vec<f64>> = sub
             .rows
@@ -647,6 +653,39 @@ mod tests {
                 .all(|&j| !map.noise[j] && map.points[j].iter().all(|x| x.is_finite()))
         );
         assert!(c.events.iter().any(|&j| map.points[j] != [0.0; 3]));
+    }
+
+    /// A component whose landmark encounters all stand at one place (a single landmark
+    /// interval: a real log that recorded one) is embedded from all its encounters: from
+    /// that one place, MaxMin picked the same spot twice and landmark MDS put every event
+    /// at the origin (found by the forty-first session's review).
+    #[test]
+    fn a_component_anchored_at_one_place_is_embedded_from_all_its_encounters() {
+        let mut log = synthetic_log(&SyntheticParams::default(), 3000);
+        let (window, params) = whole_log_embedded(&log);
+        let first = log
+            .static_intervals
+            .iter()
+            .position(|s| s.reason == crate::log::StaticReason::Landmark)
+            .unwrap();
+        log.static_intervals = vec![log.static_intervals[first].clone()];
+        let map = local_map(&log, &window, &params);
+        assert_eq!(map.components.len(), 1);
+        let c = &map.components[0];
+        assert!(c.representatives.len() >= 3, "{:?}", c.representatives);
+        let mut places: Vec<[u64; 3]> = c
+            .events
+            .iter()
+            .map(|&j| map.points[j].map(f64::to_bits))
+            .collect();
+        places.sort_unstable();
+        places.dedup();
+        assert!(
+            places.len() * 2 > c.events.len(),
+            "{} places for {} events",
+            places.len(),
+            c.events.len()
+        );
     }
 
     /// With `after_landmarks`, encounters that end before the first landmark is selected

@@ -198,6 +198,8 @@ struct ConnectionOut<'a> {
     count: usize,
     static_agents: &'a [u32],
     joins: &'a [(usize, usize)],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    also_joins: &'a [(usize, usize)],
     points: Vec<CloudPointOut>,
     merges: Vec<MergeOut>,
 }
@@ -286,6 +288,7 @@ pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> St
         count: conn.count,
         static_agents: &conn.static_agents,
         joins: &conn.joins,
+        also_joins: &conn.also_joins,
         points,
         merges,
     };

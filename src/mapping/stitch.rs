@@ -5,14 +5,20 @@
 //!
 //! S_{i,i+1} is the set of static agents with a static interval `[t^b, t^d]` that starts
 //! no later than W_{i+1} begins and ends no earlier than W_i ends: they stood still through
-//! the whole overlap, so both local maps saw them at one place. E_S is the set of their
+//! the whole overlap, so both local maps saw them at one place. This is the paper's prose;
+//! its equation writes `t^b ≤ t_i − Δt` and `t^d ≥ t_i + Δt`, twice the half-overlap
+//! `Δt / 2` by which W_{i+1} begins before and W_i ends after `t_i` (W_i = [t_{i−1} − Δt/2,
+//! t_i + Δt/2]), which would ask a landmark to stand through twice the overlap. We follow
+//! the prose, which matches the stated purpose. E_S is the set of their
 //! encounters while static, inside W_i ∪ W_{i+1}. All of one agent's E_S events lie at one
 //! point (they are joined at zero cost), so the inter-domain point cloud is, per static
 //! agent, that point together with its k nearest encounters in the encounter metric of
 //! W_i ∪ W_{i+1} (the correspondence metric). Single linkage of the cloud, cut at c
 //! (default 50 s, the paper's value), gives the clusters; each cluster is one connection.
 //! The components of M_i and M_{i+1} that a cluster's events belong to are the components
-//! the connection joins. A cluster none of whose events lies in a component of one of the
+//! the connection joins; a cluster touching several components of one map glues them all
+//! (its events show them to be one region, joined through the other window) while still
+//! counting as one connection. A cluster none of whose events lies in a component of one of the
 //! two maps (that map judged them all noise, or holds no events at all) joins nothing and
 //! is not counted: a connection is between the maps, and the global map's edges are the
 //! joins (in the 151 connections of 37 bundled runs checked in the fortieth session every
@@ -116,6 +122,35 @@ pub struct Connection {
     /// Pairs `(component of M_i, component of M_{i+1})` joined, one per cluster that
     /// touches both maps.
     pub joins: Vec<(usize, usize)>,
+    /// The further pairs a cluster glues when it touches several components of one map
+    /// (its events, through W_{i+1}, show them to be one region): with the cluster's entry
+    /// of `joins`, a spanning tree of the components it touches, so they become one region
+    /// of the global map without a cycle of its own and without counting as connections.
+    /// Written only when not empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub also_joins: Vec<(usize, usize)>,
+}
+
+/// Component pairs `(of M_i, of M_{i+1})`.
+type Pairs = Vec<(usize, usize)>;
+
+/// The pairs the clusters join, from the components each touches in M_i and M_{i+1}:
+/// `joins`, one pair per cluster touching both maps (its first component of each), and
+/// `also_joins`, the first component of each map paired with every further component the
+/// cluster touches in the other, so that each cluster's pairs form a spanning tree of what
+/// it touches (found by the forty-first session's review: only the first pair was kept, and
+/// a cluster meeting two components of one map left one of them unglued, β0 one too high).
+fn joins_of(touch: &[(BTreeSet<usize>, BTreeSet<usize>)]) -> (Pairs, Pairs) {
+    let (mut joins, mut also) = (Vec::new(), Vec::new());
+    for (a, b) in touch {
+        let (Some(&a0), Some(&b0)) = (a.first(), b.first()) else {
+            continue;
+        };
+        joins.push((a0, b0));
+        also.extend(a.iter().skip(1).map(|&ak| (ak, b0)));
+        also.extend(b.iter().skip(1).map(|&bk| (a0, bk)));
+    }
+    (joins, also)
 }
 
 /// The global topological map.
@@ -245,10 +280,7 @@ pub fn connect(
             }
         }
     }
-    let joins: Vec<(usize, usize)> = touch
-        .iter()
-        .filter_map(|(a, b)| Some((*a.first()?, *b.first()?)))
-        .collect();
+    let (joins, also_joins) = joins_of(&touch);
     // Only the clusters that join the two maps are connections between them.
     let count = joins.len();
     Connection {
@@ -260,6 +292,7 @@ pub fn connect(
         metric: Some(metric),
         count,
         joins,
+        also_joins,
     }
 }
 
@@ -594,7 +627,7 @@ pub fn global_map(maps: &[LocalMap], connections: &[Connection], log: &Encounter
     }
     let mut edges = Vec::new();
     for conn in connections {
-        for &(a, b) in &conn.joins {
+        for &(a, b) in conn.joins.iter().chain(&conn.also_joins) {
             if let (Some(&x), Some(&y)) = (
                 node_of.get(&(conn.between[0], a)),
                 node_of.get(&(conn.between[1], b)),
@@ -663,6 +696,7 @@ mod tests {
             heights: Vec::new(),
             count: 1,
             joins: vec![(0, 0)],
+            also_joins: Vec::new(),
         }
     }
 
@@ -888,6 +922,41 @@ mod tests {
 
     /// Two candidates (loops too weak for either map alone) that two windows see round
     /// one place are one hole of the global map; one candidate alone is none.
+    /// A cluster that touches two components of one map glues both to the other map's
+    /// component, as one region and one connection, with no cycle (found by the forty-first
+    /// session's review: the second component stayed unglued, global β0 one too high).
+    #[test]
+    fn a_cluster_touching_two_components_of_one_map_glues_both() {
+        let set = |v: &[usize]| v.iter().copied().collect::<BTreeSet<usize>>();
+        // Cluster 0 touches components 0 and 1 of M_i and component 0 of M_{i+1}; cluster 1
+        // touches M_i's 2 and M_{i+1}'s 1 and 2; cluster 2 touches only M_i (joins nothing).
+        let touch = vec![
+            (set(&[0, 1]), set(&[0])),
+            (set(&[2]), set(&[1, 2])),
+            (set(&[3]), set(&[])),
+        ];
+        let (joins, also) = joins_of(&touch);
+        assert_eq!(joins, vec![(0, 0), (2, 1)]);
+        assert_eq!(also, vec![(1, 0), (2, 2)]);
+
+        let log = log(&[0.0, 1.0, 2.0, 3.0]);
+        let mut m1 = planar_map(1, vec![0, 1], vec![[0.0; 2]; 2], &[]);
+        let mut second = m1.components[0].clone();
+        second.events = vec![1];
+        m1.components[0].events = vec![0];
+        m1.components.push(second);
+        let m2 = planar_map(2, vec![2, 3], vec![[0.0; 2]; 2], &[]);
+        let mut conn = one_join();
+        let maps = [m1, m2];
+        assert_eq!(
+            global_map(&maps, std::slice::from_ref(&conn), &log).betti,
+            [2, 0]
+        );
+        conn.also_joins = vec![(1, 0)];
+        let g = global_map(&maps, std::slice::from_ref(&conn), &log);
+        assert_eq!((g.betti, g.gluing_cycles), ([1, 0], 0));
+    }
+
     #[test]
     fn a_loop_two_windows_see_weakly_is_one_hole() {
         let join = one_join();

@@ -153,8 +153,9 @@ fn maxmin_counting(
             .fold((0, f64::NEG_INFINITY), |best, (k, &d)| {
                 if d > best.1 { (k, d) } else { best }
             });
-        if d <= 0.0 && picks.len() > 1 {
-            // Every remaining member coincides with a pick: nothing more to represent.
+        if d <= 0.0 {
+            // Every remaining member coincides with a pick: nothing more to represent (with
+            // one pick too: picking the same place again gave landmark MDS a zero matrix).
             break;
         }
         next = members[k];
