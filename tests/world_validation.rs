@@ -137,6 +137,23 @@ fn syntax_errors_give_file_line_col() {
     assert_has(&msg, &["t.ron:1:"]);
     let msg = error_of("(swarm: (agents: 10.5))");
     assert_has(&msg, &["t.ron:1:"]);
+    // Found by the forty-first session's review: these read "expected a comma here".
+    let msg = error_of("(arena: (width: 8.0, height: 4.0)");
+    assert_has(&msg, &["t.ron:1:", "end of the file", "closing bracket"]);
+    for (text, variant) in [
+        ("(swarm: (placement: Window()))", "Window"),
+        ("(swarm: (placement: Window(radius: 2.0)))", "Window"),
+        ("(mapping: (method: Paper(1)))", "Paper"),
+    ] {
+        let msg = error_of(text);
+        assert_has(&msg, &[&format!("`{variant}` takes nothing in brackets")]);
+    }
+    let msg = error_of("(swarm: (placement: Disk(1.0)))");
+    assert_has(&msg, &["t.ron:1:", "`field: value`", "Disk(radius: 1.0)"]);
+    assert!(!msg.contains("raw identifier"), "{msg}");
+    // A comma really missing between entries is still said so.
+    let msg = error_of("(arena: (width: 8.0 height: 4.0))");
+    assert_has(&msg, &["t.ron:1:21", "expected a comma"]);
 }
 
 #[test]

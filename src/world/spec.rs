@@ -258,6 +258,49 @@ fn explain(code: &ron::Error) -> String {
     }
 }
 
+/// What ron's "expected a comma" means at `line:col` of `text` (1-based), where the text
+/// there tells more: the file ended (a closing bracket is missing), or a variant that takes
+/// no arguments was given some (`Window()`, `Paper(1)`). (Found by the forty-first
+/// session's review: both read "expected a comma here", the first past the file's end.)
+fn comma_expected(text: &str, line: usize, col: usize) -> String {
+    let row = text.lines().nth(line.saturating_sub(1)).unwrap_or("");
+    let before: String = row.chars().take(col.saturating_sub(1)).collect();
+    let rest = text
+        .lines()
+        .skip(line.saturating_sub(1))
+        .enumerate()
+        .map(|(k, l)| {
+            if k == 0 {
+                l.chars().skip(col.saturating_sub(1)).collect()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<String>>()
+        .join("\n");
+    // Nothing but closing brackets to the end: the file ends before its brackets close.
+    if rest.chars().all(|c| c.is_whitespace() || c == ')' || c == ']') {
+        return "unexpected end of the file; a closing bracket `)` or `]` is probably missing"
+            .into();
+    }
+    let variant: String = before
+        .trim_end()
+        .chars()
+        .rev()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect::<Vec<char>>()
+        .into_iter()
+        .rev()
+        .collect();
+    if rest.starts_with('(') && variant.starts_with(|c: char| c.is_ascii_uppercase()) {
+        return format!(
+            "`{variant}` takes nothing in brackets here; write `{variant}` alone (the README's \
+             World files section gives each variant's form)"
+        );
+    }
+    "expected a comma here, between the previous entry and this one".into()
+}
+
 /// Parses RON `text` into a raw spec; `origin_name` (usually the file name) prefixes
 /// error positions: `worlds/x.ron:12:5: unknown field ...`.
 pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError> {
@@ -278,6 +321,12 @@ pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError>
             message: if matches!(e.code, ron::Error::ExpectedComma) && fraction {
                 "a whole number is expected here, not a fraction (counts and the seed are \
                      integers, e.g. `agents: 100`)"
+                    .into()
+            } else if matches!(e.code, ron::Error::ExpectedComma) {
+                comma_expected(text, line, col)
+            } else if matches!(e.code, ron::Error::SuggestRawIdentifier(_)) {
+                "a `field: value` pair is expected here, not a bare value (e.g. `Disk(radius: \
+                 1.0)`; the README's World files section gives each variant's fields)"
                     .into()
             } else {
                 explain(&e.code)
