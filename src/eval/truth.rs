@@ -81,6 +81,27 @@ use crate::world::{CellBlock, Placement, Vec2, World, clear_obstacle_cells};
 /// Default raster resolution in metres (`0.01`, i.e. 1 cm).
 pub const DEFAULT_RESOLUTION: f64 = 0.01;
 
+/// The resolution of a world's truth ([`FreeSpace::for_world`]): [`DEFAULT_RESOLUTION`],
+/// or, on an arena of more than [`MAX_CELLS`] square centimetres (20 000 m², e.g. 3 000 m
+/// × 10 m), the finest square cell that keeps the raster within [`MAX_CELLS`] cells (found
+/// by the forty-first session's review: such an arena could be simulated but its runs
+/// neither evaluated nor mapped). Passages narrower than about 2 · body radius + 2.5 ·
+/// resolution then count as closed.
+pub fn resolution_for(width: f64, height: f64) -> f64 {
+    let cells = |h: f64| (width / h).ceil() * (height / h).ceil();
+    let mut h = DEFAULT_RESOLUTION
+        .max((width * height / MAX_CELLS as f64).sqrt())
+        .max(width.max(height) / MAX_CELLS as f64);
+    // The ceilings can add a row and a column: a few steps of 1 % settle it.
+    for _ in 0..1000 {
+        if !(cells(h) > MAX_CELLS as f64) {
+            break;
+        }
+        h *= 1.01;
+    }
+    h
+}
+
 /// Largest raster accepted by [`FreeSpace::new`], in cells (`200_000_000`, about 1 GB).
 pub const MAX_CELLS: usize = 200_000_000;
 
@@ -297,9 +318,10 @@ impl FreeSpace {
         })
     }
 
-    /// [`FreeSpace::new`] at [`DEFAULT_RESOLUTION`] (1 cm).
+    /// [`FreeSpace::new`] at [`resolution_for`] the world's arena: [`DEFAULT_RESOLUTION`]
+    /// (1 cm) unless the arena is too large for [`MAX_CELLS`] cells of it.
     pub fn for_world(world: &World) -> Result<Self, TruthError> {
-        Self::new(world, DEFAULT_RESOLUTION)
+        Self::new(world, resolution_for(world.arena.width, world.arena.height))
     }
 
     /// Cell side in metres.
@@ -834,6 +856,30 @@ fn hole_cells_8(mask: &[bool], ncols: usize, ny: usize) -> Vec<Vec<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_truth_coarsens_only_for_arenas_beyond_its_cell_budget() {
+        // Every bundled world and anything up to 20 000 m² keeps 1 cm.
+        assert_eq!(resolution_for(30.0, 10.0), DEFAULT_RESOLUTION);
+        assert_eq!(resolution_for(200.0, 100.0), DEFAULT_RESOLUTION);
+        for (w, h) in [
+            (3000.0, 10.0),
+            (10_000.0, 10_000.0),
+            (10_000.0, 1e-6),
+            (1e-3, 10_000.0),
+        ] {
+            let r = resolution_for(w, h);
+            let cells = (w / r).ceil() * (h / r).ceil();
+            assert!(cells <= MAX_CELLS as f64, "{w} x {h}: {cells} cells at {r}");
+            // Not much coarser than it must be.
+            assert!(
+                r == DEFAULT_RESOLUTION
+                    || (w / (r / 1.02)).ceil() * (h / (r / 1.02)).ceil() > MAX_CELLS as f64,
+                "{w} x {h}: {r} is coarser than needed"
+            );
+        }
+        assert!((resolution_for(3000.0, 10.0) - 0.0122).abs() < 0.0002);
+    }
 
     fn grid(rows: &[&str]) -> (Vec<bool>, usize, usize) {
         // rows[0] is the top row (largest j); '#' is foreground.

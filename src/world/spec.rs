@@ -279,7 +279,10 @@ fn comma_expected(text: &str, line: usize, col: usize) -> String {
         .collect::<Vec<String>>()
         .join("\n");
     // Nothing but closing brackets to the end: the file ends before its brackets close.
-    if rest.chars().all(|c| c.is_whitespace() || c == ')' || c == ']') {
+    if rest
+        .chars()
+        .all(|c| c.is_whitespace() || c == ')' || c == ']')
+    {
         return "unexpected end of the file; a closing bracket `)` or `]` is probably missing"
             .into();
     }
