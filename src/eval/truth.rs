@@ -94,7 +94,7 @@ pub fn resolution_for(width: f64, height: f64) -> f64 {
         .max(width.max(height) / MAX_CELLS as f64);
     // The ceilings can add a row and a column: a few steps of 1 % settle it.
     for _ in 0..1000 {
-        if !(cells(h) > MAX_CELLS as f64) {
+        if cells(h) <= MAX_CELLS as f64 {
             break;
         }
         h *= 1.01;
