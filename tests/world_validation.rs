@@ -156,6 +156,26 @@ fn syntax_errors_give_file_line_col() {
     assert_has(&msg, &["t.ron:1:21", "expected a comma"]);
 }
 
+/// Found by the forty-first session's review: 2 900 agents in a 0.2 m × 1 m window passed
+/// the check (one (2·body)² square each) and the simulation gave up placing them after 11 s,
+/// at agent 2 111, where random placement jams. The check now admits 45 % cover.
+#[test]
+fn a_swarm_placement_cannot_fit_is_refused_by_the_check() {
+    let world = |agents: usize| {
+        format!(
+            "(arena: (width: 4.0, height: 1.0), swarm: (agents: {agents}, detection_radius: \
+             0.1, placement: Window), leader: (window: 0.2, end_x: 0.2), simulation: \
+             (dispersion_time: 1.0), mapping: (windows: 1, overlap: 0.0))"
+        )
+    };
+    let msg = error_of(&world(2900));
+    assert_has(
+        &msg,
+        &["t.ron:1:", "swarm.placement", "2900 agents", "at most 45 %"],
+    );
+    assert!(check_text(&world(1500)).is_ok());
+}
+
 #[test]
 fn unknown_fields_list_the_valid_ones() {
     let msg = error_of("(\n  swarm: (agents: 10, detection_radiu: 0.01),\n)");
