@@ -392,7 +392,7 @@ impl Row<'_> {
 }
 
 /// What reading a log noticed that is not an error but that a user should hear of.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadNotes {
     /// Whether `encounters.csv`'s rows were already in the log's order (by start time,
     /// then `a`, then `b`, each row's agents taken as `a < b`). Encounters are numbered in
@@ -410,6 +410,23 @@ pub struct ReadNotes {
     /// Static intervals of `static_intervals.csv` that overlap an earlier one of the same
     /// agent (an agent stands at one place at a time).
     pub overlapping_static: usize,
+    /// The files read whose last line has no line end: a file cut off while it was being
+    /// written ends that way, its last row perhaps cut short (`…,8,4` for agent 47), and
+    /// such a row still reads as a valid one.
+    pub unterminated: Vec<PathBuf>,
+}
+
+/// Whether the non-empty file at `path` ends without a line end (`\n` or `\r`).
+fn unterminated(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let Ok(mut f) = std::fs::File::open(path) else {
+        return false;
+    };
+    let mut last = [0u8; 1];
+    f.seek(SeekFrom::End(-1)).is_ok()
+        && f.read_exact(&mut last).is_ok()
+        && last[0] != b'\n'
+        && last[0] != b'\r'
 }
 
 impl EncounterLog {
@@ -466,6 +483,11 @@ impl EncounterLog {
             log.static_intervals = read_static(&st)?;
         }
         let mut notes = notes;
+        notes.unterminated = [ENCOUNTERS_CSV, STATIC_CSV, LEADER_CSV]
+            .iter()
+            .map(|f| dir.join(f))
+            .filter(|p| unterminated(p))
+            .collect();
         // Sorted by (agent, start): an interval overlaps an earlier one of its agent when
         // it starts before the latest end so far (a long interval can hold several).
         let mut latest: Option<(AgentId, f64)> = None;
@@ -589,6 +611,7 @@ fn read_encounters(path: &Path) -> Result<(Vec<Encounter>, ReadNotes), LogError>
         repeated_encounters,
         overlapping_encounters,
         overlapping_static: 0,
+        unterminated: Vec::new(),
     };
     Ok((out, notes))
 }
@@ -794,6 +817,23 @@ mod tests {
         assert_eq!(notes.overlapping_encounters, 1);
         // Agent 1's third interval; agent 2's three pauses inside its long landmark one.
         assert_eq!(notes.overlapping_static, 4);
+    }
+
+    /// Found by the forty-first session's review: a log cut off mid-row (`…,8,4` for agent
+    /// 47) reads as a valid row; a last line without a line end is noted, per file.
+    #[test]
+    fn a_last_line_without_a_line_end_is_noted() {
+        let d = dir_with(&[
+            ("encounters.csv", "start,end,a,b\n0,2,1,2\n3,4,8,4"),
+            ("static_intervals.csv", "agent,start,end\n1,0,10\n"),
+            ("leader.csv", "time,x\n0,1.5\r\n"),
+        ]);
+        let (log, notes) = EncounterLog::read_dir_noting(d.path()).unwrap();
+        assert_eq!(log.encounters.len(), 2);
+        assert_eq!(notes.unterminated, vec![d.path().join("encounters.csv")]);
+        std::fs::write(d.path().join("encounters.csv"), "start,end,a,b\n0,2,1,2\n").unwrap();
+        let (_, notes) = EncounterLog::read_dir_noting(d.path()).unwrap();
+        assert!(notes.unterminated.is_empty());
     }
 
     /// Found by the fortieth session's review: a column named twice was read from its last

@@ -445,6 +445,15 @@ fn map_warns_of_contacts_logged_twice_and_overlapping_static_intervals() {
         stderr.contains("static_intervals.csv has 1 interval(s) overlapping"),
         "{stderr}"
     );
+    assert!(!stderr.contains("no line end"), "{stderr}");
+    // A log cut off mid-row (found by the forty-first session's review).
+    let text = fs::read_to_string(&path).unwrap();
+    fs::write(&path, text.trim_end()).unwrap();
+    let stderr = map_warnings(&log, &[]);
+    assert!(
+        stderr.contains("encounters.csv's last line has no line end"),
+        "{stderr}"
+    );
 }
 
 /// `--method embedded` on a real log, with and without landmark intervals: every window

@@ -227,6 +227,26 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
         csv_path.display(),
         summary_path.display()
     );
+    // Said, not only counted in the table (found by review: the messages were collected and
+    // dropped). A failed run is stored like any other and reused by a rerun into the same
+    // DIR, as the same world and seed fail the same way.
+    let mut failures = failures.into_inner().unwrap_or_else(|e| e.into_inner());
+    failures.sort();
+    if !failures.is_empty() {
+        eprintln!(
+            "warning: {} run(s) failed and are left out of the figures (their rows in {} give \
+             the error; a rerun into {} reuses them unless their files under runs/ are removed):",
+            failures.len(),
+            csv_path.display(),
+            args.out.display()
+        );
+        for f in failures.iter().take(10) {
+            eprintln!("  {f}");
+        }
+        if failures.len() > 10 {
+            eprintln!("  … and {} more", failures.len() - 10);
+        }
+    }
     Ok(())
 }
 

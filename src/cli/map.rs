@@ -228,6 +228,14 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             notes.overlapping_encounters
         );
     }
+    for path in &notes.unterminated {
+        eprintln!(
+            "warning: {}'s last line has no line end: was the file cut off while it was being \
+             written? Its last row was read as it stands, perhaps cut short (an agent 47 read as \
+             4); check it, or end the line if the file is whole",
+            path.display()
+        );
+    }
     if notes.overlapping_static > 0 {
         eprintln!(
             "warning: {} has {} interval(s) overlapping an earlier one of the same agent; an \
