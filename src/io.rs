@@ -74,6 +74,22 @@ fn is_ignored(s: libc::c_int) -> bool {
     }
 }
 
+/// A JSON error of the file at `path` as `FILE:LINE:COL` and what is wrong there
+/// (`serde_json` writes the place in prose at the end: "… at line 1 column 110").
+pub fn json_error_at(path: &Path, e: &serde_json::Error) -> (String, String) {
+    let text = e.to_string();
+    let what = match text.rsplit_once(" at line ") {
+        Some((what, _)) if e.line() > 0 => what.to_string(),
+        _ => text,
+    };
+    let place = if e.line() > 0 {
+        format!("{}:{}:{}", path.display(), e.line(), e.column())
+    } else {
+        path.display().to_string()
+    };
+    (place, what)
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomic_with(path, |w| w.write_all(bytes))

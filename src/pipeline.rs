@@ -91,8 +91,13 @@ fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, Pipelin
         message,
     };
     let text = std::fs::read_to_string(&path).map_err(|e| meta_err(e.to_string()))?;
-    let value =
-        serde_json::from_str(&text).map_err(|e| meta_err(format!("not valid JSON: {e}")))?;
+    let value = serde_json::from_str(&text).map_err(|e| {
+        let (place, what) = crate::io::json_error_at(&path, &e);
+        PipelineError::Meta {
+            path: PathBuf::from(place),
+            message: format!("not valid JSON: {what}"),
+        }
+    })?;
     Ok(Some((path, value)))
 }
 

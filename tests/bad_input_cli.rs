@@ -1046,3 +1046,29 @@ fn set_accepts_some_and_none_and_refuses_a_half_quoted_name() {
         .code(2)
         .stderr(contains("a quoted name must be one whole string"));
 }
+
+/// Found by the forty-first session's review: a JSON error of `meta.json` or `summary.json`
+/// gave its place in prose ("at line 1 column 8") after the message, not as `file:line:col`.
+#[test]
+fn json_errors_name_their_file_line_and_column() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "run");
+    let summary = std::fs::read_to_string(run.join("summary.json")).unwrap();
+    std::fs::write(run.join("summary.json"), &summary[..40]).unwrap();
+    let out = swarmmap().arg("report").arg(&run).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    // Cut after 40 bytes: the error is on the line where the text ends.
+    let line = summary[..40].lines().count();
+    assert!(
+        stderr.contains(&format!("summary.json:{line}:")),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(" at line "), "{stderr}");
+    let meta = std::fs::read_to_string(run.join("meta.json")).unwrap();
+    std::fs::write(run.join("meta.json"), meta.replacen('{', "{ \"x\": ,", 1)).unwrap();
+    let out = swarmmap().arg("map").arg(&run).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("meta.json:1:8: not valid JSON"), "{stderr}");
+}

@@ -175,7 +175,10 @@ fn read_json<T: DeserializeOwned>(path: &Path, hint: &'static str) -> Result<T, 
         }
         Err(e) => return Err(invalid(path, e.to_string())),
     };
-    serde_json::from_str(&text).map_err(|e| invalid(path, format!("not a swarmmap output: {e}")))
+    serde_json::from_str(&text).map_err(|e| {
+        let (place, what) = crate::io::json_error_at(path, &e);
+        invalid(Path::new(&place), format!("not a swarmmap output: {what}"))
+    })
 }
 
 /// `summary.json` (at `summary`) lists a `what` numbered `index` whose file `path` must
