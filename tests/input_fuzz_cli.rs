@@ -625,11 +625,17 @@ fn set_without_equals_sign_is_a_bad_setting() {
         let mut spec = empty_world();
         let err = apply_assignment(&mut spec, assignment).unwrap_err();
         assert!(
-            matches!(err, WorldError::BadSetting { .. }),
+            matches!(err, WorldError::NoValue { .. }),
             "{assignment:?}: {err:?}"
         );
         assert!(
             err.to_string().contains("expected PATH=VALUE"),
+            "{assignment:?}: {err}"
+        );
+        // Echoed as given, not with an `=` it did not have (forty-first session's review).
+        assert!(
+            err.to_string()
+                .starts_with(&format!("--set {assignment}: expected")),
             "{assignment:?}: {err}"
         );
     }

@@ -152,6 +152,26 @@ fn check_applies_overrides() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("expected PATH=VALUE"));
+    // Counts read as counts, and a quoted number gets the fix (forty-first session's review).
+    let tmp = tempfile::tempdir().unwrap();
+    let one = tmp.path().join("one.ron");
+    std::fs::write(&one, "(swarm: (agents: 1))").unwrap();
+    swarmmap()
+        .arg("check")
+        .arg(&one)
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("1 agent, 0 landmarks"));
+    let quoted = tmp.path().join("quoted.ron");
+    std::fs::write(&quoted, "(swarm: (agents: \"ten\"))").unwrap();
+    swarmmap()
+        .arg("check")
+        .arg(&quoted)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "quoted.ron:1:17: a whole number is expected",
+        ));
 }
 
 #[test]

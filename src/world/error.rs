@@ -49,6 +49,15 @@ pub enum WorldError {
         /// Every valid path, comma-separated.
         valid: String,
     },
+    /// An override without `=` (found by the forty-first session's review: it was echoed
+    /// as `--set PATH=:`).
+    #[error(
+        "--set {given}: expected PATH=VALUE, e.g. `swarm.detection_radius=0.03`; give the value after `=`"
+    )]
+    NoValue {
+        /// The override as given.
+        given: String,
+    },
     /// An override is malformed or its value does not parse as the field's type.
     #[error("--set {path}={value}: {message}")]
     BadSetting {

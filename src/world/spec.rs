@@ -249,6 +249,10 @@ fn explain(code: &ron::Error) -> String {
             format!("the field `{field}` is given twice; keep only one")
         }
         E::Eof => "unexpected end of the file; a closing bracket is probably missing".into(),
+        E::ExpectedInteger => "a whole number is expected here (counts and the seed are \
+             written as digits, e.g. `agents: 100`, not in quotes or words)"
+            .into(),
+        E::ExpectedFloat => "a number is expected here (e.g. `0.1`, `1e-3`; not in quotes)".into(),
         E::ExpectedComma => "expected a comma here, between the previous entry and this one".into(),
         E::IntegerOutOfBounds => "this whole number is out of range for its field (a count or \
              a seed cannot be negative, and a seed is below 2^64; the README's World files \
@@ -610,10 +614,8 @@ pub fn apply_override(spec: &mut WorldSpec, path: &str, value: &str) -> Result<(
 pub fn apply_assignment(spec: &mut WorldSpec, assignment: &str) -> Result<(), WorldError> {
     match assignment.split_once('=') {
         Some((path, value)) => spec.set(path, value),
-        None => Err(WorldError::BadSetting {
-            path: assignment.to_string(),
-            value: String::new(),
-            message: "expected PATH=VALUE, e.g. `swarm.detection_radius=0.03`".into(),
+        None => Err(WorldError::NoValue {
+            given: assignment.to_string(),
         }),
     }
 }

@@ -120,9 +120,11 @@ impl World {
         );
         let _ = writeln!(
             s,
-            "swarm      {} agents, {} landmarks ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in {}",
+            "swarm      {} agent{}, {} landmark{} ({} %), r_d = {} m, v_m = {} m/s, body radius {} m, placed in {}",
             sw.agents,
+            if sw.agents == 1 { "" } else { "s" },
             landmarks,
+            if landmarks == 1 { "" } else { "s" },
             short(100.0 * sw.landmark_fraction),
             given(sw.detection_radius),
             given(sw.speed),
