@@ -86,7 +86,7 @@ use crate::eval::holes::encircles;
 use crate::eval::{Similarity, procrustes};
 use crate::log::{AgentId, EncounterLog, StaticReason};
 use crate::topology::DistanceMatrix;
-use crate::topology::linkage::{UnionFind, single_linkage};
+use crate::topology::linkage::{Dendrogram, UnionFind, single_linkage};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -129,6 +129,14 @@ pub struct Connection {
     /// Written only when not empty.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub also_joins: Vec<(usize, usize)>,
+}
+
+/// The correspondence metric's distance between anchors no path joins.
+const UNREACHABLE: f64 = f64::MAX;
+
+/// The clusters of `dendrogram` cut at `cutoff`, [`UNREACHABLE`] pairs kept apart.
+fn cut(dendrogram: &Dendrogram, cutoff: f64) -> Vec<usize> {
+    dendrogram.cut(cutoff.min(UNREACHABLE.next_down()))
 }
 
 /// Component pairs `(of M_i, of M_{i+1})`.
@@ -253,13 +261,14 @@ pub fn connect(
         .into_par_iter()
         .map(|a| graph.distances_to(cloud[a], &cloud[a + 1..]))
         .collect();
-    // Unreachable pairs are infinitely far: they never merge below any finite cut-off.
+    // Unreachable pairs are infinitely far, stored as `f64::MAX`: they never merge, whatever
+    // the cut-off (the largest float passes the world check, and would merge them).
     let metric = DistanceMatrix::from_fn(cloud.len(), |a, b| {
         let d = rows[a][b - a - 1];
-        if d.is_finite() { d } else { f64::MAX }
+        if d.is_finite() { d } else { UNREACHABLE }
     });
     let dendrogram = single_linkage(&metric);
-    let labels = dendrogram.cut(p.cutoff);
+    let labels = cut(&dendrogram, p.cutoff);
     let clusters = labels.iter().copied().max().map_or(0, |m| m + 1);
     // Which components each cluster touches, through all E_S events of its anchors.
     let (ca, cb) = (component_of_events(ma), component_of_events(mb));
@@ -922,6 +931,20 @@ mod tests {
 
     /// Two candidates (loops too weak for either map alone) that two windows see round
     /// one place are one hole of the global map; one candidate alone is none.
+    /// Anchors no path joins stay apart even at the largest cut-off the world check lets
+    /// through (found by the forty-first session's review: `f64::MAX` merged them).
+    #[test]
+    fn unreachable_anchors_never_merge() {
+        let metric =
+            DistanceMatrix::from_fn(3, |a, b| if (a, b) == (0, 1) { 2.0 } else { UNREACHABLE });
+        let dendrogram = single_linkage(&metric);
+        for cutoff in [2.0, 1e300, f64::MAX] {
+            let labels = cut(&dendrogram, cutoff);
+            assert_eq!(labels[0], labels[1]);
+            assert_ne!(labels[0], labels[2], "cut-off {cutoff}");
+        }
+    }
+
     /// A cluster that touches two components of one map glues both to the other map's
     /// component, as one region and one connection, with no cycle (found by the forty-first
     /// session's review: the second component stayed unglued, global β0 one too high).
