@@ -194,6 +194,7 @@ pub fn judged_world(
             ),
         })?;
     spec.origin.name = format!("{} (judged_world)", summary_path.display());
+    spec.origin.recorded = true;
     Ok(Some(spec.check()?))
 }
 
@@ -221,6 +222,7 @@ pub fn spec_from_run(dir: &Path) -> Result<Option<WorldSpec>, PipelineError> {
         ))
     })?;
     spec.origin.name = format!("{} (world)", path.display());
+    spec.origin.recorded = true;
     Ok(Some(spec))
 }
 

@@ -177,6 +177,40 @@ fn run_warns_of_what_map_would() {
     }
 }
 
+/// A run's recorded world is not asked again whether its placement area holds the agents:
+/// they were placed (found by the forty-first session's review: the tightened bound would
+/// have refused to map runs made before it).
+#[test]
+fn a_recorded_world_is_not_refused_by_a_tighter_placement_bound() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--no-report", "--quiet", "--out"])
+        .arg(&dir)
+        .assert()
+        .success();
+    let meta_path = dir.join("meta.json");
+    let mut meta = json(&meta_path);
+    meta["world"]["swarm"]["agents"] = serde_json::json!(300_000);
+    fs::write(&meta_path, serde_json::to_string(&meta).unwrap()).unwrap();
+    swarmmap().arg("map").arg(&dir).assert().success();
+    // The same world as a file is refused: it could not be placed.
+    let file = tmp.path().join("packed.ron");
+    fs::write(
+        &file,
+        fs::read_to_string(TINY)
+            .unwrap()
+            .replace("agents: 40", "agents: 300000"),
+    )
+    .unwrap();
+    swarmmap()
+        .arg("check")
+        .arg(&file)
+        .assert()
+        .code(2)
+        .stderr(contains("at most 45 %"));
+}
+
 /// Regression: `map` on a run made with `--seed 3` wrote `"seed": 1` into summary.json (the
 /// world file's own `seed` field, from meta.json's copy of the world) instead of the run's.
 #[test]

@@ -829,7 +829,8 @@ impl Run<'_> {
             .log
             .encounters
             .iter()
-            .filter(|e| e.start <= c)
+            // The final log's windows take its rounded starts (`as_written`): so does the cut.
+            .filter(|e| crate::log::written(e.start, &mut String::new()) <= c)
             .cloned()
             .collect();
         let mut static_intervals = self.log.static_intervals.clone();
@@ -971,7 +972,12 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         }
         if let Some((cuts, hand_out)) = opts.prefixes {
             while let Some(&c) = cuts.get(next_cut) {
-                if t < c || run.open.values().any(|&(start, _)| start <= c) {
+                if t < c
+                    || run
+                        .open
+                        .values()
+                        .any(|&(start, _)| crate::log::written(start, &mut String::new()) <= c)
+                {
                     break;
                 }
                 hand_out(next_cut, &|| run.prefix(c, t + dt));

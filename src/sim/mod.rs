@@ -41,6 +41,7 @@ mod output;
 mod params;
 mod physics;
 mod placement;
+pub use placement::PLACEMENT_GAP;
 
 pub use engine::{LEADER_INTERVAL, RETURN_ESCAPE, RETURN_NOISE, simulate};
 pub use output::{

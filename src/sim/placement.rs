@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 /// Extra gap kept between a new agent and obstacles or other agents, metres, so that no
 /// contact exists at `t = 0`.
-const GAP: f64 = 1e-4;
+pub const PLACEMENT_GAP: f64 = 1e-4;
 
 /// Draws per agent before giving up.
 const ATTEMPTS_PER_AGENT: usize = 10_000;
@@ -35,7 +35,7 @@ pub(crate) fn place(world: &World, rng: &mut ChaCha8Rng) -> Result<Vec<(f64, f64
             ((x0, 0.0), (x1, h), None)
         }
     };
-    let cell = 2.0 * r + GAP;
+    let cell = 2.0 * r + PLACEMENT_GAP;
     let key = |p: (f64, f64)| ((p.0 / cell).floor() as i64, (p.1 / cell).floor() as i64);
     let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
     let mut placed: Vec<(f64, f64)> = Vec::with_capacity(n);
@@ -59,7 +59,7 @@ pub(crate) fn place(world: &World, rng: &mut ChaCha8Rng) -> Result<Vec<(f64, f64
         {
             continue;
         }
-        if !world.is_free(p, r + GAP) {
+        if !world.is_free(p, r + PLACEMENT_GAP) {
             continue;
         }
         let (kx, ky) = key(p);

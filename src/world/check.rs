@@ -927,7 +927,14 @@ pub const PLACEMENT_COVER: f64 = 0.45;
 /// leader visits must contain some free space.
 fn check_free_space(ctx: &Ctx<'_>, world: &World) -> Result<(), WorldError> {
     let body = world.swarm.body_radius;
-    let need = world.swarm.agents as f64 * std::f64::consts::PI * body * body / PLACEMENT_COVER;
+    // Each body keeps placement's gap to the next.
+    let reach = body + crate::sim::PLACEMENT_GAP / 2.0;
+    let need = if ctx.origin.recorded {
+        // A run's world: its agents were placed (module docs of `SpecOrigin::recorded`).
+        0.0
+    } else {
+        world.swarm.agents as f64 * std::f64::consts::PI * reach * reach / PLACEMENT_COVER
+    };
     let (xs, h) = (world.leader.start_x, world.arena.height);
     let half = world.leader.window / 2.0;
     match world.swarm.placement {

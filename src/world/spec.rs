@@ -165,6 +165,10 @@ pub struct SpecOrigin {
     pub text: Option<String>,
     /// `(path, value)` of every override applied, in order.
     pub overrides: Vec<(String, String)>,
+    /// A world a run recorded (`meta.json`): its agents were placed, so the check does not
+    /// ask again whether the placement area holds them (a bound tightened since would
+    /// otherwise refuse to map or report a run made before).
+    pub recorded: bool,
 }
 
 /// A world as written: every section and field optional. Turn it into a validated
@@ -344,6 +348,7 @@ pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError>
         name: origin_name.to_string(),
         text: Some(text.to_string()),
         overrides: Vec::new(),
+        recorded: false,
     };
     Ok(spec)
 }
