@@ -54,7 +54,11 @@ fn mapping_alongside_the_simulation_writes_what_mapping_afterwards_writes() {
         // Cuts at 85.1 and 155.1 s, where the step at 1702 · 0.05 = 85.10000000000001 s is written
         // (and mapped) as 85.1: the prefix must cut the rounded starts too (found by the
         // forty-first session's review).
-        &["mapping.windows=3", "mapping.overlap=30.2", "swarm.agents=200"],
+        &[
+            "mapping.windows=3",
+            "mapping.overlap=30.2",
+            "swarm.agents=200",
+        ],
         &[
             "mapping.windows=5",
             "mapping.method=Paper",

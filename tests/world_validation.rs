@@ -151,6 +151,20 @@ fn syntax_errors_give_file_line_col() {
     let msg = error_of("(swarm: (placement: Disk(1.0)))");
     assert_has(&msg, &["t.ron:1:", "`field: value`", "Disk(radius: 1.0)"]);
     assert!(!msg.contains("raw identifier"), "{msg}");
+    // A closer of the wrong kind, and field names written as paths or with hyphens (found
+    // by the review of the first fix).
+    let msg = error_of("(arena: (width: 8.0, height: 4.0])");
+    assert_has(
+        &msg,
+        &["t.ron:1:33", "this `]` closes", "close it with `)`"],
+    );
+    let msg = error_of("(swarm.agents: 10)");
+    assert_has(
+        &msg,
+        &["`swarm.agents` is not a field name", "swarm: (agents: 10)"],
+    );
+    let msg = error_of("(swarm: (detection-radius: 0.1))");
+    assert_has(&msg, &["`detection-radius` is not a field name", "`_`"]);
     // A comma really missing between entries is still said so.
     let msg = error_of("(arena: (width: 8.0 height: 4.0))");
     assert_has(&msg, &["t.ron:1:21", "expected a comma"]);

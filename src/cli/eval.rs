@@ -203,7 +203,7 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
         if let Some(e) = &r.error
             && let Ok(mut f) = failures.lock()
         {
-            f.push(format!("{} seed {}: {e}", r.world_file, r.seed));
+            f.push((r.world_file.clone(), r.params.clone(), r.seed, e.clone()));
         }
         if let Some(b) = &bar {
             b.inc(1);
@@ -240,8 +240,13 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
             csv_path.display(),
             args.out.display()
         );
-        for f in failures.iter().take(10) {
-            eprintln!("  {f}");
+        for (world, params, seed, e) in failures.iter().take(10) {
+            let params = if params.is_empty() {
+                String::new()
+            } else {
+                format!(" [{params}]")
+            };
+            eprintln!("  {world}{params} seed {seed}: {e}");
         }
         if failures.len() > 10 {
             eprintln!("  … and {} more", failures.len() - 10);

@@ -93,7 +93,8 @@ pub fn run_seed(flag: Option<u64>, sets: &[String]) -> Result<Option<u64>, Failu
 pub fn refuse_seed_set(sets: &[String]) -> Result<(), Failure> {
     match seed_set(sets) {
         Some(set) => Err(input(anyhow::anyhow!(
-            "--set {set}: each run's seed comes from --seeds, which replaces the world's; give              the seeds as --seeds (a range A..B or a list like 1,2,5)"
+            "--set {set}: each run's seed comes from --seeds, which replaces the world's; give \
+             the seeds as --seeds (a range A..B or a list like 1,2,5)"
         ))),
         None => Ok(()),
     }

@@ -151,7 +151,8 @@ fn run_warnings(
             empty.join(", "),
             mapped.maps.len()
         ));
-    } else if mapped.summary.global.betti[0] == 0 {
+    }
+    if mapped.summary.global.betti[0] == 0 {
         out.push(format!(
             "every window's encounters were judged noise (β0 = 0 everywhere) although the run \
              recorded {} encounter(s): too few for {} window(s); fewer windows \

@@ -20,14 +20,17 @@
 //! (its events show them to be one region, joined through the other window) while still
 //! counting as one connection. A cluster none of whose events lies in a component of one of the
 //! two maps (that map judged them all noise, or holds no events at all) joins nothing and
-//! is not counted: a connection is between the maps, and the global map's edges are the
-//! joins (in the 151 connections of 37 bundled runs checked in the fortieth session every
+//! is not counted: a connection is between the maps, and the global map's edges are its
+//! joins and also-joins (in the 151 connections of 37 bundled runs checked in the fortieth session every
 //! cluster joins, so their counts are as before).
 //!
 //! # The global map and its Betti numbers
 //!
 //! The global map is a multigraph G whose nodes are the components of all local maps
-//! (each carrying its robust holes) and whose edges are the connections. Then
+//! (each carrying its robust holes) and whose edges are the connections' joins (one per
+//! connection) and also-joins (a connection's cluster touching several components of one
+//! map glues each of them in, as a tree: it adds no cycle of its own, though with another
+//! connection between the same regions it closes one, as any second connection does). Then
 //! - β0 = the number of connected components of G: local components glued by
 //!   connections are one region;
 //! - β1 = (E − V + β0) + (the distinct local holes). The first term is the cycle rank of
@@ -929,8 +932,6 @@ mod tests {
         (log(&times), first, second)
     }
 
-    /// Two candidates (loops too weak for either map alone) that two windows see round
-    /// one place are one hole of the global map; one candidate alone is none.
     /// Anchors no path joins stay apart even at the largest cut-off the world check lets
     /// through (found by the forty-first session's review: `f64::MAX` merged them).
     #[test]
@@ -980,6 +981,8 @@ mod tests {
         assert_eq!((g.betti, g.gluing_cycles), ([1, 0], 0));
     }
 
+    /// Two candidates (loops too weak for either map alone) that two windows see round
+    /// one place are one hole of the global map; one candidate alone is none.
     #[test]
     fn a_loop_two_windows_see_weakly_is_one_hole() {
         let join = one_join();

@@ -286,10 +286,31 @@ fn comma_expected(text: &str, line: usize, col: usize) -> String {
         })
         .collect::<Vec<String>>()
         .join("\n");
-    // Nothing but closing brackets to the end: the file ends before its brackets close.
+    // A closer of the wrong kind: `(… 4.0]`.
+    let prefix: String = text
+        .lines()
+        .take(line.saturating_sub(1))
+        .map(|l| format!("{l}\n"))
+        .chain(std::iter::once(before.clone()))
+        .collect();
+    let wanted = match open_brackets(&prefix).last() {
+        Some('(') => Some(')'),
+        Some('[') => Some(']'),
+        _ => None,
+    };
+    if let (Some(wanted), Some(found @ (')' | ']'))) = (wanted, rest.chars().next())
+        && wanted != found
+    {
+        return format!(
+            "this `{found}` closes a bracket opened with the other kind; close it with `{wanted}`"
+        );
+    }
+    // Nothing but closing brackets to the end, fewer than the file opens: it ends before
+    // its brackets close.
     if rest
         .chars()
         .all(|c| c.is_whitespace() || c == ')' || c == ']')
+        && !open_brackets(text).is_empty()
     {
         return "unexpected end of the file; a closing bracket `)` or `]` is probably missing"
             .into();
@@ -310,6 +331,71 @@ fn comma_expected(text: &str, line: usize, col: usize) -> String {
         );
     }
     "expected a comma here, between the previous entry and this one".into()
+}
+
+/// The brackets `text` leaves open, innermost last, outside strings and comments.
+fn open_brackets(text: &str) -> Vec<char> {
+    let mut open = Vec::new();
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                while let Some(d) = chars.next() {
+                    match d {
+                        '\\' => {
+                            chars.next();
+                        }
+                        '"' => break,
+                        _ => {}
+                    }
+                }
+            }
+            '/' if chars.peek() == Some(&'/') => {
+                for d in chars.by_ref() {
+                    if d == '\n' {
+                        break;
+                    }
+                }
+            }
+            '/' if chars.peek() == Some(&'*') => {
+                chars.next();
+                let mut last = ' ';
+                for d in chars.by_ref() {
+                    if last == '*' && d == '/' {
+                        break;
+                    }
+                    last = d;
+                }
+            }
+            '(' | '[' | '{' => open.push(c),
+            ')' | ']' | '}' => {
+                open.pop();
+            }
+            _ => {}
+        }
+    }
+    open
+}
+
+/// What ron's suggestion of a raw identifier means: `found` stood where a field name was
+/// expected.
+fn not_a_field_name(found: &str) -> String {
+    let word = found.chars().next().is_some_and(char::is_alphabetic);
+    if word && found.contains('.') {
+        format!(
+            "`{found}` is not a field name: a dotted path is for --set; in a file write the \
+             section, e.g. `swarm: (agents: 10)`"
+        )
+    } else if word && found.contains('-') {
+        format!(
+            "`{found}` is not a field name: field names join words with `_`, e.g. \
+             `detection_radius`"
+        )
+    } else {
+        "a `field: value` pair is expected here, not a bare value (e.g. `Disk(radius: 1.0)`; \
+         the README's World files section gives each variant's fields)"
+            .into()
+    }
 }
 
 /// Parses RON `text` into a raw spec; `origin_name` (usually the file name) prefixes
@@ -335,10 +421,8 @@ pub fn parse_str(text: &str, origin_name: &str) -> Result<WorldSpec, WorldError>
                     .into()
             } else if matches!(e.code, ron::Error::ExpectedComma) {
                 comma_expected(text, line, col)
-            } else if matches!(e.code, ron::Error::SuggestRawIdentifier(_)) {
-                "a `field: value` pair is expected here, not a bare value (e.g. `Disk(radius: \
-                 1.0)`; the README's World files section gives each variant's fields)"
-                    .into()
+            } else if let ron::Error::SuggestRawIdentifier(found) = &e.code {
+                not_a_field_name(found)
             } else {
                 explain(&e.code)
             },
