@@ -142,7 +142,9 @@ fn a_false_hole_cap_outside_0_to_1_is_an_input_error() {
 fn calibrate_refuses_one_file_for_two_outputs_and_a_seed_set() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("model.json");
-    let same = dir.path().join(".").join("model.json");
+    // The same file by another path (`Path` equality already ignores `.`, not `..`).
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let same = dir.path().join("sub").join("..").join("model.json");
     for (extra, said) in [
         (
             vec!["--landscape".to_string(), same.display().to_string()],

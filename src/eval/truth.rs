@@ -92,12 +92,25 @@ pub fn resolution_for(width: f64, height: f64) -> f64 {
     let mut h = DEFAULT_RESOLUTION
         .max((width * height / MAX_CELLS as f64).sqrt())
         .max(width.max(height) / MAX_CELLS as f64);
-    // The ceilings can add a row and a column: a few steps of 1 % settle it.
+    // The ceilings can add a row and a column: steps of 1 % find a side that fits, and
+    // halving the last step brings it to the finest that does.
+    let first = h;
     for _ in 0..1000 {
         if cells(h) <= MAX_CELLS as f64 {
             break;
         }
         h *= 1.01;
+    }
+    if h > first {
+        let mut too_fine = h / 1.01;
+        for _ in 0..50 {
+            let mid = 0.5 * (too_fine + h);
+            if cells(mid) <= MAX_CELLS as f64 {
+                h = mid;
+            } else {
+                too_fine = mid;
+            }
+        }
     }
     h
 }
@@ -192,7 +205,7 @@ pub struct BandComponents {
 impl FreeSpace {
     /// Rasterises the reachable free space of `world` at `resolution` metres per cell
     /// (use [`DEFAULT_RESOLUTION`], 1 cm, unless the world has passages narrower than about
-    /// 2 · body radius + 3 · resolution).
+    /// 2 · body radius + 2.5 · resolution).
     pub fn new(world: &World, resolution: f64) -> Result<Self, TruthError> {
         if !(resolution.is_finite() && resolution > 0.0) {
             return Err(TruthError::BadResolution(resolution));
@@ -871,14 +884,15 @@ mod tests {
             let r = resolution_for(w, h);
             let cells = (w / r).ceil() * (h / r).ceil();
             assert!(cells <= MAX_CELLS as f64, "{w} x {h}: {cells} cells at {r}");
-            // Not much coarser than it must be.
+            // No coarser than it must be.
+            let finer = r * (1.0 - 1e-9);
             assert!(
                 r == DEFAULT_RESOLUTION
-                    || (w / (r / 1.02)).ceil() * (h / (r / 1.02)).ceil() > MAX_CELLS as f64,
+                    || (w / finer).ceil() * (h / finer).ceil() > MAX_CELLS as f64,
                 "{w} x {h}: {r} is coarser than needed"
             );
         }
-        assert!((resolution_for(3000.0, 10.0) - 0.0122).abs() < 0.0002);
+        assert!((resolution_for(3000.0, 10.0) - 0.012255).abs() < 1e-6);
     }
 
     fn grid(rows: &[&str]) -> (Vec<bool>, usize, usize) {
