@@ -13,6 +13,19 @@ fn swarmmap() -> Command {
     Command::cargo_bin("swarmmap").unwrap()
 }
 
+/// `swarmmap run` of the tiny world without its report, in a fresh directory (kept while
+/// the returned guard lives).
+fn tiny_run_without_report() -> (tempfile::TempDir, std::path::PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    swarmmap()
+        .args(["run", TINY, "--no-report", "--quiet", "--out"])
+        .arg(&dir)
+        .assert()
+        .success();
+    (tmp, dir)
+}
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -80,13 +93,7 @@ fn run_writes_every_output_and_is_deterministic() {
 /// numbers). The simulator now hands out the log as written.
 #[test]
 fn mapping_a_run_again_from_its_files_gives_its_maps() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    swarmmap()
-        .args(["run", TINY, "--no-report", "--quiet", "--out"])
-        .arg(&dir)
-        .assert()
-        .success();
+    let (_tmp, dir) = tiny_run_without_report();
     let maps = |dir: &Path| -> Vec<(String, Vec<u8>)> {
         let mut v: Vec<_> = fs::read_dir(dir.join("maps"))
             .unwrap()
@@ -182,13 +189,7 @@ fn run_warns_of_what_map_would() {
 /// have refused to map runs made before it).
 #[test]
 fn a_recorded_world_is_not_refused_by_a_tighter_placement_bound() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    swarmmap()
-        .args(["run", TINY, "--no-report", "--quiet", "--out"])
-        .arg(&dir)
-        .assert()
-        .success();
+    let (tmp, dir) = tiny_run_without_report();
     let meta_path = dir.join("meta.json");
     let mut meta = json(&meta_path);
     meta["world"]["swarm"]["agents"] = serde_json::json!(300_000);
@@ -797,13 +798,7 @@ fn map_with(dir: &Path, model: &Path) -> assert_cmd::assert::Assert {
 /// is written.
 #[test]
 fn a_model_file_replaces_the_shipped_thresholds() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    swarmmap()
-        .args(["run", TINY, "--no-report", "--quiet", "--out"])
-        .arg(&dir)
-        .assert()
-        .success();
+    let (tmp, dir) = tiny_run_without_report();
     // No H1 bar of a finite diagram has death / birth ≥ 10⁹: no hole anywhere.
     let strict = model_file(tmp.path(), "strict.json", 1e9, 0.0);
     map_with(&dir, &strict).success();

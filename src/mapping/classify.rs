@@ -662,15 +662,20 @@ mod tests {
         Feature::bar(dim, birth, death)
     }
 
-    #[test]
-    fn the_rule_is_scale_invariant() {
-        let c = Classifier {
+    /// H0 ratio 5, H1 ratio 2 and span 3, no crossing or stability test.
+    fn ratio_2_span_3() -> Classifier {
+        Classifier {
             h0_ratio: 5.0,
             h1_ratio: 2.0,
             h1_span: 3.0,
             h1_crossing: None,
             h1_stability: None,
-        };
+        }
+    }
+
+    #[test]
+    fn the_rule_is_scale_invariant() {
+        let c = ratio_2_span_3();
         let diagram = vec![
             f(0, 0.0, 1.0),
             f(0, 0.0, 1.0),
@@ -692,13 +697,7 @@ mod tests {
     /// (`≥`; found by the forty-first session's review: it was `>`).
     #[test]
     fn a_bar_born_at_zero_is_judged_by_its_life() {
-        let c = Classifier {
-            h0_ratio: 5.0,
-            h1_ratio: 2.0,
-            h1_span: 3.0,
-            h1_crossing: None,
-            h1_stability: None,
-        };
+        let c = ratio_2_span_3();
         assert!(c.robust(&f(1, 0.0, 6.0), 2.0));
         assert!(c.robust(&f(1, 3.0, 9.0), 2.0));
         assert!(!c.robust(&f(1, 0.0, 5.9), 2.0));
