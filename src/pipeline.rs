@@ -183,18 +183,12 @@ pub fn judged_world(
     let Some(value) = judged else {
         return world_from_run(dir);
     };
-    let mut spec: WorldSpec =
-        serde_path_to_error::deserialize(value.clone()).map_err(|e| PipelineError::Meta {
-            path: summary_path.to_path_buf(),
-            message: format!(
-                "its `judged_world` is not a valid world: judged_world.{}: {}; map the run \
-                 again",
-                e.path(),
-                e.inner()
-            ),
-        })?;
-    spec.origin.name = format!("{} (judged_world)", summary_path.display());
-    spec.origin.recorded = true;
+    let spec = recorded_spec(
+        value.clone(),
+        summary_path,
+        "judged_world",
+        "map the run again",
+    )?;
     Ok(Some(spec.check()?))
 }
 
@@ -212,18 +206,37 @@ pub fn spec_from_run(dir: &Path) -> Result<Option<WorldSpec>, PipelineError> {
         .get("world")
         .cloned()
         .ok_or_else(|| meta_err("has no `world` object; is it a swarmmap run?".into()))?;
-    // With the path of the field at fault: "world.arena.width: invalid type: …".
-    let mut spec: WorldSpec = serde_path_to_error::deserialize(world).map_err(|e| {
-        meta_err(format!(
-            "its `world` is not a valid world: world.{}: {}; fix that field, or simulate \
-             the run again",
-            e.path(),
-            e.inner()
-        ))
-    })?;
-    spec.origin.name = format!("{} (world)", path.display());
+    recorded_spec(
+        world,
+        &path,
+        "world",
+        "fix that field, or simulate the run again",
+    )
+    .map(Some)
+}
+
+/// The world spec a run recorded as `field` of the JSON file at `path` (`meta.json`'s
+/// `world`, `summary.json`'s `judged_world`), marked as recorded (its agents were placed);
+/// an invalid one is an error naming the field at fault ("world.arena.width: invalid type:
+/// …") and `fix`.
+fn recorded_spec(
+    value: serde_json::Value,
+    path: &Path,
+    field: &str,
+    fix: &str,
+) -> Result<WorldSpec, PipelineError> {
+    let mut spec: WorldSpec =
+        serde_path_to_error::deserialize(value).map_err(|e| PipelineError::Meta {
+            path: path.to_path_buf(),
+            message: format!(
+                "its `{field}` is not a valid world: {field}.{}: {}; {fix}",
+                e.path(),
+                e.inner()
+            ),
+        })?;
+    spec.origin.name = format!("{} ({field})", path.display());
     spec.origin.recorded = true;
-    Ok(Some(spec))
+    Ok(spec)
 }
 
 /// Maps a log: local maps of every window, connections, the global map, and (with the

@@ -204,9 +204,6 @@ struct ConnectionOut<'a> {
     merges: Vec<MergeOut>,
 }
 
-/// Distances at or above this are "not connected" (the stitcher stores `f64::MAX` for them).
-const UNREACHABLE: f64 = f64::MAX / 2.0;
-
 /// The JSON text of `maps/connection_<i>.json`: the inter-domain cloud of one pair of
 /// windows with its cluster labels, a 2-D projection for drawing and its single-linkage
 /// merges (for the dendrogram), and the cut-off `cutoff` (seconds) it was cut at.
@@ -225,7 +222,8 @@ pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> St
                 .map(|m| MergeOut {
                     a: m.a,
                     b: m.b,
-                    height: (m.height.is_finite() && m.height < UNREACHABLE).then_some(m.height),
+                    height: (m.height.is_finite() && m.height < super::stitch::UNREACHABLE)
+                        .then_some(m.height),
                     size: m.size,
                 })
                 .collect();
@@ -233,7 +231,7 @@ pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> St
                 .condensed()
                 .iter()
                 .copied()
-                .filter(|d| d.is_finite() && *d < UNREACHABLE)
+                .filter(|d| d.is_finite() && *d < super::stitch::UNREACHABLE)
                 .fold(0.0f64, f64::max);
             let far = if finite_max > 0.0 {
                 2.0 * finite_max
@@ -242,7 +240,7 @@ pub fn connection_json(conn: &Connection, log: &EncounterLog, cutoff: f64) -> St
             };
             let display = DistanceMatrix::from_fn(n, |i, j| {
                 let d = metric.get(i, j);
-                if d.is_finite() && d < UNREACHABLE {
+                if d.is_finite() && d < super::stitch::UNREACHABLE {
                     d
                 } else {
                     far

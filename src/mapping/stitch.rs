@@ -134,8 +134,9 @@ pub struct Connection {
     pub also_joins: Vec<(usize, usize)>,
 }
 
-/// The correspondence metric's distance between anchors no path joins.
-const UNREACHABLE: f64 = f64::MAX;
+/// The correspondence metric's distance between anchors no path joins (written as
+/// `null` in the maps).
+pub(crate) const UNREACHABLE: f64 = f64::MAX;
 
 /// The clusters of `dendrogram` cut at `cutoff`, [`UNREACHABLE`] pairs kept apart.
 fn cut(dendrogram: &Dendrogram, cutoff: f64) -> Vec<usize> {
