@@ -98,7 +98,31 @@ fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, Pipelin
             message: format!("not valid JSON: {what}"),
         }
     })?;
+    check_format(&value).map_err(meta_err)?;
     Ok(Some((path, value)))
+}
+
+/// The format tag `meta.json` files are written with ([`crate::sim::output`]).
+pub const META_FORMAT: &str = "swarmmap-simulation/1";
+
+/// Refuses a `meta.json` whose `format` is not [`META_FORMAT`]: a later format's fields
+/// may mean other things, and a file of another tool's is not a run. A file without the
+/// field (written by hand beside a real experiment's log) is read as it stands.
+fn check_format(meta: &serde_json::Value) -> Result<(), String> {
+    match meta.get("format") {
+        None => Ok(()),
+        Some(serde_json::Value::String(f)) if f == META_FORMAT => Ok(()),
+        Some(serde_json::Value::String(f)) if f.starts_with("swarmmap-simulation/") => {
+            Err(format!(
+                "`format` is \"{f}\", which this build of swarmmap does not read (it reads \"{META_FORMAT}\"); \
+             map it with the swarmmap that wrote it, or simulate the run again"
+            ))
+        }
+        Some(other) => Err(format!(
+            "`format` is {other}, not \"{META_FORMAT}\": not a swarmmap run's meta.json; \
+             move the file away to map the log without it"
+        )),
+    }
 }
 
 /// The seed a simulation ran with, from the top-level `seed` of its `meta.json` (not the

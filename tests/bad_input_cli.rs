@@ -1072,3 +1072,37 @@ fn json_errors_name_their_file_line_and_column() {
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("meta.json:1:8: not valid JSON"), "{stderr}");
 }
+
+/// Left alone by the forty-first session: `meta.json`'s format tag was never read, so a file
+/// of a later format (or another tool's) was taken for this build's. A file without the
+/// tag (written by hand beside a real log) is still read.
+#[test]
+fn meta_json_of_another_format_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tiny_run(tmp.path(), "simulate");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap();
+    let cases = [
+        (
+            serde_json::json!("swarmmap-simulation/2"),
+            "`format` is \"swarmmap-simulation/2\", which this build of swarmmap does not read",
+        ),
+        (
+            serde_json::json!(7),
+            "`format` is 7, not \"swarmmap-simulation/1\": not a swarmmap run's meta.json",
+        ),
+    ];
+    for (format, message) in cases {
+        meta["format"] = format;
+        fs::write(run.join("meta.json"), meta.to_string()).unwrap();
+        swarmmap()
+            .arg("map")
+            .arg(&run)
+            .assert()
+            .code(2)
+            .stderr(contains("meta.json").and(contains(message)));
+    }
+    meta.as_object_mut().unwrap().remove("format");
+    fs::write(run.join("meta.json"), meta.to_string()).unwrap();
+    swarmmap().arg("map").arg(&run).assert().success();
+}

@@ -630,3 +630,25 @@ fn runs_kept_with_runs_dir_are_reused_and_fit_the_same_model() {
     assert_eq!(again, first);
     assert_eq!(std::fs::read_to_string(&out).unwrap(), fitted);
 }
+
+/// Left alone by the forty-first session: on training worlds whose every window holds a
+/// hole the false-hole cap is vacuous, and `calibrate` said nothing. The tiny world's disc
+/// lies in both its windows; with the cap lifted (`--max-false-holes 1`) there is nothing
+/// to warn of.
+#[test]
+fn calibrate_warns_when_no_training_window_is_hole_free() {
+    let dir = tempfile::tempdir().unwrap();
+    let warning = "warning: none of the 2 training windows is hole-free, so --max-false-holes \
+                   constrained nothing";
+    let fit = |extra: &[&str]| {
+        Command::cargo_bin("swarmmap")
+            .unwrap()
+            .args(["calibrate", WORLD, "--seeds", "1", "--jobs", "1", "--out"])
+            .arg(dir.path().join("model.json"))
+            .args(extra)
+            .assert()
+            .success()
+    };
+    fit(&[]).stderr(contains(warning));
+    fit(&["--max-false-holes", "1"]).stderr(contains("hole-free, so").not());
+}

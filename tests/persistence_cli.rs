@@ -117,6 +117,24 @@ fn bad_files_name_the_line_and_exit_2() {
         ":3: row has 1 columns but line 1 has 2",
     );
     bad("0,0\n1,x\n", &[], ":2: field 2: 'x' is not a number");
+    // Left alone by the forty-first session: a header row, `;` separators or spaces got
+    // only "not a number".
+    bad(
+        "x,y\n0,0\n",
+        &[],
+        ":1: field 1: 'x' is not a number; this looks like a header row",
+    );
+    bad("0,0\n1,x\n", &[], "every field must be a decimal number");
+    bad(
+        "0;0\n1;2\n",
+        &[],
+        ":1: field 1: '0;0' is not a number; fields are separated by commas, not ';'",
+    );
+    bad(
+        "0 0\n1 2\n",
+        &[],
+        ":1: field 1: '0 0' is not a number; fields are separated by commas, not spaces or tabs",
+    );
     bad(
         "0,0\n1,nan\n",
         &[],

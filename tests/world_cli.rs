@@ -41,6 +41,7 @@ fn check_prints_a_summary_of_each_scenario() {
             .args(["check", file])
             .assert()
             .success()
+            .stderr(predicate::str::is_empty())
             .stdout(predicate::str::contains(format!("obstacles  {obstacles}")))
             .stdout(predicate::str::contains("30 m × 10 m"))
             .stdout(predicate::str::contains("200 agents, 60 landmarks"))
@@ -258,4 +259,29 @@ fn obstacles_scale_grows_every_obstacle_and_blames_itself_when_they_leave_the_ar
         .assert()
         .code(2)
         .stderr(predicate::str::contains("must be a finite number > 0"));
+}
+
+/// Left alone by the forty-first session: `check` passed a world whose swarm has no
+/// landmark (or a single agent) in silence, though its runs cannot be stitched (or record
+/// nothing); `run` only said so after the simulation.
+#[test]
+fn check_warns_of_a_swarm_without_landmarks_or_partners() {
+    for (set, warning) in [
+        (
+            "swarm.landmark_fraction=0.002",
+            "warning: no agent will be a landmark (round(swarm.landmark_fraction × agents) = \
+             round(0.002 × 200) = 0)",
+        ),
+        (
+            "swarm.agents=1",
+            "warning: 1 agent meets no one: the run will record no encounters",
+        ),
+    ] {
+        swarmmap()
+            .args(["check", "worlds/scenario1.ron", "--set", set])
+            .assert()
+            .success()
+            .stdout(predicate::str::contains("world      scenario1"))
+            .stderr(predicate::str::contains(warning));
+    }
 }

@@ -571,6 +571,15 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         );
+        if samples.iter().all(|s| s.truth[1] > 0) && args.max_false_holes < 1.0 {
+            eprintln!(
+                "warning: none of the {} training windows is hole-free, so --max-false-holes \
+                 constrained nothing and the {} fit may show holes where there are none; add a \
+                 world without obstacles to the training worlds (e.g. worlds/training/t_empty.ron)",
+                samples.len(),
+                target_name(method)
+            );
+        }
         if args.landscape.is_some() {
             let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
             for p in h1_landscape(samples, options) {

@@ -22,5 +22,8 @@ pub fn run(args: &CheckArgs) -> Result<(), Failure> {
     super::apply_sets(&mut spec, &args.set)?;
     let world = spec.check().map_err(input)?;
     println!("{}", world.summary());
+    for w in world.warnings() {
+        eprintln!("warning: {w}");
+    }
     Ok(())
 }

@@ -113,8 +113,9 @@ fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
         let mut vals = Vec::with_capacity(rec.len());
         for (col, field) in rec.iter().enumerate() {
             let v: f64 = field.parse().map_err(|_| {
+                let fix = not_a_number_fix(field, &rec, rows.is_empty());
                 format!(
-                    "{line}: field {}: '{field}' is not a number; every field must be a decimal number",
+                    "{line}: field {}: '{field}' is not a number; {fix}",
                     col + 1
                 )
             })?;
@@ -135,6 +136,23 @@ fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
         return Err(" the file has no rows; expected one point (or matrix row) per line".into());
     }
     Ok(rows)
+}
+
+/// How to mend a field that is not a number, from what the line looks like: another
+/// separator (a spreadsheet's `;` or a tab), or a header (`first`: no row read yet, and no
+/// field of the line is a number).
+fn not_a_number_fix(field: &str, record: &csv::StringRecord, first: bool) -> &'static str {
+    if field.contains(';') {
+        "fields are separated by commas, not ';' (a spreadsheet's export with decimal commas?): \
+         write each number with a decimal point and separate them with ','"
+    } else if field.contains('\t') || field.contains(' ') {
+        "fields are separated by commas, not spaces or tabs: separate the numbers with ','"
+    } else if first && record.iter().all(|f| f.parse::<f64>().is_err()) {
+        "this looks like a header row, and the file takes none: delete the line (the columns \
+         are the coordinates, or the matrix's columns, in order)"
+    } else {
+        "every field must be a decimal number"
+    }
 }
 
 fn points(rows: &[Row]) -> Result<PointCloud, MatrixError> {

@@ -173,7 +173,7 @@ pub fn meta_json(world: &World, out: &SimOutput) -> Vec<u8> {
         files.push("trajectories.csv");
     }
     let meta = json!({
-        "format": "swarmmap-simulation/1",
+        "format": crate::pipeline::META_FORMAT,
         "crate_version": env!("CARGO_PKG_VERSION"),
         "world": world_json(world),
         "seed": out.seed,

@@ -208,4 +208,30 @@ impl World {
         let _ = write!(s, "seed       {}", self.seed);
         s
     }
+
+    /// What a valid world will not do that its author likely wants (printed by `swarmmap
+    /// check` as warnings; `run` and `map` say the same of the run's log afterwards).
+    pub fn warnings(&self) -> Vec<String> {
+        let sw = &self.swarm;
+        let mut out = Vec::new();
+        if sw.agents < 2 {
+            out.push(format!(
+                "{} agent{} meet{} no one: the run will record no encounters and every map \
+                 will be empty; give swarm.agents at least 2",
+                sw.agents,
+                if sw.agents == 1 { "" } else { "s" },
+                if sw.agents == 1 { "s" } else { "" },
+            ));
+        } else if landmark_count(sw.landmark_fraction, sw.agents) == 0 {
+            out.push(format!(
+                "no agent will be a landmark (round(swarm.landmark_fraction × agents) = \
+                 round({} × {}) = 0): no static agent bridges time or stands through the \
+                 windows' overlaps, so consecutive local maps cannot be stitched; raise \
+                 swarm.landmark_fraction (the paper's is 0.1) or swarm.agents",
+                given(sw.landmark_fraction),
+                sw.agents
+            ));
+        }
+        out
+    }
 }
