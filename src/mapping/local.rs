@@ -115,6 +115,7 @@ impl LocalParams {
     pub fn from_mapping_at(m: &crate::world::MappingParams, sweep: f64) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
+        p.subsample.k = super::subsample::rank_for_sweep(sweep);
         p.classifier = super::classify::Models::active()
             .get(m.method)
             .for_sweep(sweep);

@@ -13,6 +13,28 @@
 //! k-NN radius exceeds `outlier_factor` times the median, and keep the first m survivors
 //! in MaxMin order. Cost: O(oversample · m · (n + E) log n) time, O(m · n) memory.
 //!
+//! The radius counts encounters, not places. Among the `Embedded` method's candidates (the
+//! encounters with landmarks) every encounter of one landmark interval is at distance 0
+//! from the others, so a landmark met more than k times has a radius of 0; once such
+//! landmarks are half the picks the median is 0 and every landmark met k times or fewer is
+//! dropped, wherever it stands. The filter then keeps the landmarks met often, whose
+//! distances rest on many walks. Measured on scenario 3, seeds 1–20 (docs/accuracy.md,
+//! steps 49 and 50):
+//! - a radius that counts a landmark's copies once keeps the rarely met landmarks (and
+//!   still drops the strays) and makes the maps worse: 14 global maps right of 20 against
+//!   15, 13 with the classifier refitted;
+//! - k = 16 instead of 8 makes them better: 18 of 20, and 16 of the held-out seeds 21–40
+//!   (was 14), but scenarios 1 and 2, swept twice as fast, get worse (18 and 16 of 20
+//!   against 20 and 18).
+//!
+//! The count a landmark reaches grows with how long it stands, and a landmark stands
+//! while the leader's domain (l metres wide) passes it: l / v_leader, twice as long in
+//! scenario 3, whose leader sweeps at half the paper's speed (scenario 2 seed 7: landmark
+//! intervals over 60 s last a median 352 s, 75th and 90th percentiles of their encounters
+//! 35 and 52; scenario 3 seed 7: 716 s, 57 and 96). So the rank scales with the sweep
+//! ([`rank_for_sweep`]): k = 8 at the paper's 0.005 m/s, 16 at scenario 3's 0.0025 m/s;
+//! a landmark met at the same rate, not the same number of times, counts as sparse.
+//!
 //! The picks are sequential (each needs the previous one's row), so when cores would
 //! otherwise sit idle, [`maxmin_with`] computes the rows of the likely next picks beside
 //! each needed one; the result is the same, bit for bit.
@@ -37,7 +59,8 @@ pub struct SubsampleParams {
     /// Candidates per kept representative (default: `1.0`: outliers are dropped from the m
     /// picks, so a window may keep slightly fewer than m).
     pub oversample: f64,
-    /// Neighbour rank k of the density estimate (default: `8`).
+    /// Neighbour rank k of the density estimate (default: `8`; a world's mapping scales
+    /// it with the sweep: [`rank_for_sweep`]).
     pub k: usize,
     /// A candidate whose k-NN radius exceeds this multiple of the median is an outlier
     /// (default: `3.0`).
@@ -54,6 +77,24 @@ impl Default for SubsampleParams {
         }
     }
 }
+
+/// The neighbour rank k of the density estimate for a leader sweeping at `sweep` m/s: 8 at
+/// the paper's sweep ([`super::classify::DEFAULT_SWEEP`], every shipped model's), in
+/// proportion to how long a landmark stands (`l / sweep`) elsewhere (module docs), within
+/// 1 to [`MAX_RANK`].
+pub fn rank_for_sweep(sweep: f64) -> usize {
+    let base = SubsampleParams::default().k as f64;
+    let k = base * super::classify::DEFAULT_SWEEP / sweep;
+    if k.is_finite() {
+        (k.round() as usize).clamp(1, MAX_RANK)
+    } else {
+        MAX_RANK
+    }
+}
+
+/// The largest neighbour rank [`rank_for_sweep`] gives (a sweep 100 times slower than the
+/// paper's).
+pub const MAX_RANK: usize = 800;
 
 /// Farthest-point selection of up to `count` encounters among `members` (one connected
 /// component), starting from the member farthest from `members[0]` so the start does not
@@ -321,6 +362,90 @@ mod tests {
             "the stray encounter is an outlier: {:?}",
             s.picks
         );
+    }
+
+    /// The rank scales with how long a landmark stands, l / sweep: 8 at the paper's sweep,
+    /// 16 at scenario 3's half speed, within 1 to [`MAX_RANK`].
+    #[test]
+    fn the_rank_scales_with_the_sweep() {
+        let cases = [
+            (0.005, 8),
+            (0.0025, 16),
+            (0.01, 4),
+            (0.02, 2),
+            (1.0, 1),
+            (1e-5, MAX_RANK),
+            (f64::MIN_POSITIVE, MAX_RANK),
+        ];
+        for (sweep, k) in cases {
+            assert_eq!(rank_for_sweep(sweep), k, "sweep {sweep}");
+        }
+        let world = crate::world::World::load("worlds/scenario3.ron").unwrap();
+        let cfg = crate::mapping::pipeline::MapConfig::for_world(&world);
+        assert_eq!(cfg.local.subsample.k, 16);
+        let world = crate::world::World::load("worlds/scenario2.ron").unwrap();
+        let cfg = crate::mapping::pipeline::MapConfig::for_world(&world);
+        assert_eq!(cfg.local.subsample.k, 8);
+    }
+
+    /// The filter's radius counts encounters (module docs): ten landmarks stand one second
+    /// apart along a walker's line, landmarks 0 and 9 met twice, the others twenty times
+    /// each, and one more is met once 1000 s later (a stray). Each landmark is one MaxMin
+    /// pick (its encounters are at distance 0 from each other); with k = 3 the landmarks
+    /// met twenty times have a radius of 0, so the median is 0, and the landmarks met
+    /// three times or fewer are dropped with the stray.
+    #[test]
+    fn landmarks_met_k_times_or_fewer_are_dropped_where_the_median_radius_is_0() {
+        use crate::log::{StaticInterval, StaticReason};
+        let mut enc = Vec::new();
+        let mut statics = Vec::new();
+        for l in 0..11u32 {
+            let at = if l == 10 { 1000.0 } else { l as f64 };
+            let met = match l {
+                0 | 9 => 2,
+                10 => 1,
+                _ => 20,
+            };
+            statics.push(StaticInterval {
+                agent: l,
+                start: 0.0,
+                end: 2000.0,
+                reason: StaticReason::Landmark,
+            });
+            for c in 0..met {
+                // The walker (agent 100) meets the landmark at `at`; other passers meet it
+                // once each, a little later.
+                let (b, t) = if c == 0 {
+                    (100, at)
+                } else {
+                    (200 + 20 * l + c, at + 0.001 * c as f64)
+                };
+                enc.push(Encounter {
+                    start: t,
+                    end: t,
+                    a: l,
+                    b,
+                    truth: None,
+                });
+            }
+        }
+        let g = EncounterGraph::build(&enc, &statics, Bridging::Paper);
+        let members: Vec<usize> = (0..enc.len()).collect();
+        let all = maxmin(&g, &members, 40);
+        let landmarks = |picks: &[usize]| {
+            let mut l: Vec<u32> = picks.iter().map(|&j| enc[j].a).collect();
+            l.sort_unstable();
+            l
+        };
+        assert_eq!(landmarks(&all.picks), (0..11).collect::<Vec<u32>>());
+        let p = SubsampleParams {
+            m: 40,
+            oversample: 1.0,
+            k: 3,
+            outlier_factor: 3.0,
+        };
+        let kept = subsample(&g, &members, &p);
+        assert_eq!(landmarks(&kept.picks), (1..9).collect::<Vec<u32>>());
     }
 
     /// Guessing rows ahead changes nothing but the time: the picks and every row are
