@@ -135,6 +135,23 @@ fn bad_files_name_the_line_and_exit_2() {
         &[],
         ":1: field 1: '0 0' is not a number; fields are separated by commas, not spaces or tabs",
     );
+    // Found in review: a header with spaces got the separator hint, an empty first row the
+    // header hint, and a quoted decimal comma only "not a number".
+    bad(
+        "x coord,y coord\n0,0\n",
+        &[],
+        ":1: field 1: 'x coord' is not a number; this looks like a header row",
+    );
+    bad(
+        ",\n0,0\n",
+        &[],
+        ":1: field 1: '' is not a number; the field is empty",
+    );
+    bad(
+        "0,\"1,5\"\n0,0\n",
+        &[],
+        ":1: field 2: '1,5' is not a number; write the number with a decimal point",
+    );
     bad(
         "0,0\n1,nan\n",
         &[],

@@ -269,8 +269,8 @@ fn check_warns_of_a_swarm_without_landmarks_or_partners() {
     for (set, warning) in [
         (
             "swarm.landmark_fraction=0.002",
-            "warning: no agent will be a landmark (round(swarm.landmark_fraction × agents) = \
-             round(0.002 × 200) = 0)",
+            "warning: no agent will be a landmark, even with every agent inside the leader's \
+             domain (round(swarm.landmark_fraction × agents) = round(0.002 × 200) = 0;",
         ),
         (
             "swarm.agents=1",

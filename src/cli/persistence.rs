@@ -138,18 +138,36 @@ fn parse_rows(bytes: &[u8]) -> Result<Vec<Row>, String> {
     Ok(rows)
 }
 
-/// How to mend a field that is not a number, from what the line looks like: another
-/// separator (a spreadsheet's `;` or a tab), or a header (`first`: no row read yet, and no
-/// field of the line is a number).
+/// How to mend a field that is not a number, from what the line looks like: a header
+/// (`first`: no row read yet, and no field of the line is a number, none of them empty), an
+/// empty field, a decimal comma (a quoted `1,5`), or another separator (a spreadsheet's
+/// `;`, spaces or tabs).
 fn not_a_number_fix(field: &str, record: &csv::StringRecord, first: bool) -> &'static str {
-    if field.contains(';') {
-        "fields are separated by commas, not ';' (a spreadsheet's export with decimal commas?): \
-         write each number with a decimal point and separate them with ','"
-    } else if field.contains('\t') || field.contains(' ') {
-        "fields are separated by commas, not spaces or tabs: separate the numbers with ','"
-    } else if first && record.iter().all(|f| f.parse::<f64>().is_err()) {
+    let number = |f: &str| f.parse::<f64>().is_ok();
+    // Numbers joined by another separator: `0;0`, `1,5;2,5` (decimal commas), `0 0`.
+    let separated = |f: &str| {
+        f.contains([';', '\t', ' '])
+            && f.split([';', '\t', ' '])
+                .filter(|p| !p.is_empty())
+                .all(|p| number(&p.replacen(',', ".", 1)))
+    };
+    if first
+        && record
+            .iter()
+            .all(|f| !f.is_empty() && !number(f) && !separated(f))
+    {
         "this looks like a header row, and the file takes none: delete the line (the columns \
          are the coordinates, or the matrix's columns, in order)"
+    } else if field.is_empty() {
+        "the field is empty: write a number there, or remove the extra comma"
+    } else if number(&field.replacen(',', ".", 1)) {
+        "write the number with a decimal point, not a decimal comma"
+    } else if separated(field) && field.contains(';') {
+        "fields are separated by commas, not ';' (a spreadsheet's export with decimal commas?): \
+         write each number with a decimal point and separate them with ','"
+    } else if separated(field) {
+        "fields are separated by commas, not spaces or tabs (and numbers take no thousands \
+         separator): separate the numbers with ','"
     } else {
         "every field must be a decimal number"
     }

@@ -81,10 +81,14 @@ impl Default for SubsampleParams {
 /// The neighbour rank k of the density estimate for a leader sweeping at `sweep` m/s: 8 at
 /// the paper's sweep ([`super::classify::DEFAULT_SWEEP`], every shipped model's), in
 /// proportion to how long a landmark stands (`l / sweep`) elsewhere (module docs), within
-/// 1 to [`MAX_RANK`].
+/// 1 to [`MAX_RANK`]. A sweep that is not positive and finite counts as the paper's, as
+/// in [`super::classify::Bank::for_sweep`].
 pub fn rank_for_sweep(sweep: f64) -> usize {
-    let base = SubsampleParams::default().k as f64;
-    let k = base * super::classify::DEFAULT_SWEEP / sweep;
+    let base = SubsampleParams::default().k;
+    if !(sweep.is_finite() && sweep > 0.0) {
+        return base;
+    }
+    let k = base as f64 * super::classify::DEFAULT_SWEEP / sweep;
     if k.is_finite() {
         (k.round() as usize).clamp(1, MAX_RANK)
     } else {
@@ -376,6 +380,10 @@ mod tests {
             (1.0, 1),
             (1e-5, MAX_RANK),
             (f64::MIN_POSITIVE, MAX_RANK),
+            (0.0, 8),
+            (-0.005, 8),
+            (f64::NAN, 8),
+            (f64::INFINITY, 8),
         ];
         for (sweep, k) in cases {
             assert_eq!(rank_for_sweep(sweep), k, "sweep {sweep}");

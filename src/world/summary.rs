@@ -215,17 +215,17 @@ impl World {
         let sw = &self.swarm;
         let mut out = Vec::new();
         if sw.agents < 2 {
-            out.push(format!(
-                "{} agent{} meet{} no one: the run will record no encounters and every map \
-                 will be empty; give swarm.agents at least 2",
-                sw.agents,
-                if sw.agents == 1 { "" } else { "s" },
-                if sw.agents == 1 { "s" } else { "" },
-            ));
+            out.push(
+                "1 agent meets no one: the run will record no encounters and every map will \
+                 be empty; give swarm.agents at least 2"
+                    .to_string(),
+            );
         } else if landmark_count(sw.landmark_fraction, sw.agents) == 0 {
             out.push(format!(
-                "no agent will be a landmark (round(swarm.landmark_fraction × agents) = \
-                 round({} × {}) = 0): no static agent bridges time or stands through the \
+                "no agent will be a landmark, even with every agent inside the leader's \
+                 domain (round(swarm.landmark_fraction × agents) = round({} × {}) = 0; \
+                 the simulator counts only the agents inside it): no static agent bridges \
+                 time or stands through the \
                  windows' overlaps, so consecutive local maps cannot be stitched; raise \
                  swarm.landmark_fraction (the paper's is 0.1) or swarm.agents",
                 given(sw.landmark_fraction),
