@@ -102,13 +102,12 @@ fn read_meta(dir: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, Pipelin
     Ok(Some((path, value)))
 }
 
-/// The format tag `meta.json` files are written with ([`crate::sim::output`]).
-pub const META_FORMAT: &str = "swarmmap-simulation/1";
-
-/// Refuses a `meta.json` whose `format` is not [`META_FORMAT`]: a later format's fields
-/// may mean other things, and a file of another tool's is not a run. A file without the
-/// field (written by hand beside a real experiment's log) is read as it stands.
+/// Refuses a `meta.json` whose `format` is not [`crate::sim::META_FORMAT`], the one this
+/// build writes: a later format's fields may mean other things, and a file of another
+/// tool's is not a run. A file without the field (written by hand beside a real
+/// experiment's log) is read as it stands.
 fn check_format(meta: &serde_json::Value) -> Result<(), String> {
+    use crate::sim::META_FORMAT;
     match meta.get("format") {
         None => Ok(()),
         Some(serde_json::Value::String(f)) if f == META_FORMAT => Ok(()),

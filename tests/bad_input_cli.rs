@@ -943,8 +943,7 @@ fn a_fraction_where_a_whole_number_belongs_is_named() {
 fn a_bad_field_in_meta_json_is_named_by_its_path() {
     let tmp = tempfile::tempdir().unwrap();
     let run = tiny_run(tmp.path(), "simulate");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap();
+    let mut meta = meta_json(&run);
     meta["world"]["arena"]["width"] = serde_json::json!("wide");
     fs::write(run.join("meta.json"), meta.to_string()).unwrap();
     swarmmap()
@@ -1080,8 +1079,7 @@ fn json_errors_name_their_file_line_and_column() {
 fn meta_json_of_another_format_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let run = tiny_run(tmp.path(), "simulate");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap();
+    let mut meta = meta_json(&run);
     let cases = [
         (
             serde_json::json!("swarmmap-simulation/2"),
@@ -1105,4 +1103,9 @@ fn meta_json_of_another_format_is_refused() {
     meta.as_object_mut().unwrap().remove("format");
     fs::write(run.join("meta.json"), meta.to_string()).unwrap();
     swarmmap().arg("map").arg(&run).assert().success();
+}
+
+/// A run's `meta.json` as JSON, to edit and write back.
+fn meta_json(run: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&fs::read_to_string(run.join("meta.json")).unwrap()).unwrap()
 }

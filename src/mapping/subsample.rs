@@ -88,12 +88,10 @@ pub fn rank_for_sweep(sweep: f64) -> usize {
     if !(sweep.is_finite() && sweep > 0.0) {
         return base;
     }
+    // A float-to-integer cast saturates (an infinite k from a subnormal sweep is
+    // `usize::MAX`), so the clamp bounds every case.
     let k = base as f64 * super::classify::DEFAULT_SWEEP / sweep;
-    if k.is_finite() {
-        (k.round() as usize).clamp(1, MAX_RANK)
-    } else {
-        MAX_RANK
-    }
+    (k.round() as usize).clamp(1, MAX_RANK)
 }
 
 /// The largest neighbour rank [`rank_for_sweep`] gives (a sweep 100 times slower than the
@@ -380,6 +378,7 @@ mod tests {
             (1.0, 1),
             (1e-5, MAX_RANK),
             (f64::MIN_POSITIVE, MAX_RANK),
+            (5e-324, MAX_RANK),
             (0.0, 8),
             (-0.005, 8),
             (f64::NAN, 8),

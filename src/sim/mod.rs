@@ -45,8 +45,8 @@ pub use placement::PLACEMENT_GAP;
 
 pub use engine::{LEADER_INTERVAL, RETURN_ESCAPE, RETURN_NOISE, simulate};
 pub use output::{
-    encounters_csv, leader_csv, meta_json, prepare_out_dir, static_intervals_csv, trajectories_csv,
-    world_json, write_run,
+    META_FORMAT, encounters_csv, leader_csv, meta_json, prepare_out_dir, static_intervals_csv,
+    trajectories_csv, world_json, write_run,
 };
 pub use params::{
     AgentState, PrefixSink, SimError, SimOptions, SimOutput, SimStats, Trajectories,

@@ -173,7 +173,7 @@ pub fn meta_json(world: &World, out: &SimOutput) -> Vec<u8> {
         files.push("trajectories.csv");
     }
     let meta = json!({
-        "format": crate::pipeline::META_FORMAT,
+        "format": META_FORMAT,
         "crate_version": env!("CARGO_PKG_VERSION"),
         "world": world_json(world),
         "seed": out.seed,
@@ -224,6 +224,10 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), SimError> {
     let path = dir.join(name);
     write_atomic(&path, bytes).map_err(|source| SimError::Write { path, source })
 }
+
+/// The format tag of the `meta.json` files this build writes, and the only one
+/// [`crate::pipeline`] reads.
+pub const META_FORMAT: &str = "swarmmap-simulation/1";
 
 /// Removes an earlier run in `dir` before a new log replaces it: first what was derived
 /// from its log (`summary.json`, the report in `report/`, the maps in `maps/`: each
