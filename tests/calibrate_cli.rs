@@ -634,7 +634,7 @@ fn runs_kept_with_runs_dir_are_reused_and_fit_the_same_model() {
 /// Left alone by the forty-first session: on training worlds whose every window holds a
 /// hole the false-hole cap is vacuous, and `calibrate` said nothing. The tiny world's disc
 /// lies in both its windows; with the cap lifted (`--max-false-holes 1`) there is nothing
-/// to warn of.
+/// to warn of, and `--with-oracle` warns once for both its fits.
 #[test]
 fn calibrate_warns_when_no_training_window_is_hole_free() {
     let dir = tempfile::tempdir().unwrap();
@@ -649,6 +649,15 @@ fn calibrate_warns_when_no_training_window_is_hole_free() {
             .assert()
             .success()
     };
-    fit(&[]).stderr(contains(warning));
+    fit(&[]).stderr(contains(warning).and(contains("the Paper fit may show holes")));
     fit(&["--max-false-holes", "1"]).stderr(contains("hole-free, so").not());
+    // With the oracle fitted on the same windows: one warning naming both fits (it was
+    // printed once per fit, the forty-second session's note).
+    let both = fit(&["--with-oracle"]);
+    let stderr = String::from_utf8_lossy(&both.get_output().stderr).into_owned();
+    assert_eq!(stderr.matches("hole-free, so").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("the Paper and Oracle fits may show holes"),
+        "{stderr}"
+    );
 }

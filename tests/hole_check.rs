@@ -68,6 +68,7 @@ fn map_with(truth_len: usize, cycles: Vec<Vec<(usize, usize)>>) -> LocalMap {
         }],
         betti: [1, 0],
         explained: 1.0,
+        outlier_rank: 8,
         events_per_point: 1.0,
         classifier: swarmmap::mapping::classify::Classifier::default(),
         rows: Vec::new(),

@@ -413,6 +413,79 @@ fn map_warns_of_windows_far_sparser_than_the_models_training() {
     assert!(!fine.contains("Rips vertex"), "{fine}");
 }
 
+/// `map --sweep` gives a log without a world its leader's sweep: the outlier rank
+/// (recorded in each window's JSON) and the models fitted nearest it follow; a sweep that is
+/// not a positive speed, or that differs from the world's, is refused with no output.
+#[test]
+fn map_sweep_picks_the_rank_and_models_of_a_worldless_log() {
+    let tmp = tempfile::tempdir().unwrap();
+    let log = real_log(tmp.path());
+    // The shipped models, plus a Paper model at the tiny world's 0.02 m/s marked by an H1
+    // ratio no data reaches.
+    let mut models = swarmmap::mapping::classify::Models::shipped();
+    let mut marked = models.paper.0[0].clone();
+    marked.leader_speed = Some(0.02);
+    marked.events_per_point = None;
+    marked.classifier.h1_ratio = 1e9;
+    models.paper.0.push(marked);
+    let model = tmp.path().join("models.json");
+    fs::write(&model, serde_json::to_string(&models).unwrap()).unwrap();
+    let windows = |extra: &[&str]| -> Vec<serde_json::Value> {
+        swarmmap()
+            .arg("--model")
+            .arg(&model)
+            .args(["map", "--windows", "2", "--overlap", "30"])
+            .args(extra)
+            .arg(&log)
+            .assert()
+            .success();
+        (1..=2)
+            .map(|i| json(&log.join(format!("maps/window_{i}.json"))))
+            .collect()
+    };
+    for (extra, rank, marked) in [
+        (&[][..], 8, false),
+        (&["--sweep", "0.005"][..], 8, false),
+        (&["--sweep", "0.02"][..], 2, true),
+        (&["--sweep", "0.0025"][..], 16, false),
+    ] {
+        for w in windows(extra) {
+            assert_eq!(w["outlier_rank"], rank, "{extra:?}");
+            assert_eq!(w["classifier"]["h1_ratio"] == 1e9, marked, "{extra:?}");
+        }
+    }
+    let before = fs::read(log.join("summary.json")).unwrap();
+    for (extra, says) in [
+        (
+            &["--sweep", "0"][..],
+            "--sweep is 0; it is the leader's sweep speed",
+        ),
+        (&["--sweep", "-0.005"][..], "a positive number"),
+        (&["--sweep", "inf"][..], "a positive number"),
+        (&["--sweep", "NaN"][..], "a positive number"),
+        (
+            &["--world", TINY, "--sweep", "0.005"][..],
+            "sweeps at 0.02 m/s (its leader.speed)",
+        ),
+    ] {
+        swarmmap()
+            .args(["map", "--windows", "2", "--overlap", "30"])
+            .args(extra)
+            .arg(&log)
+            .assert()
+            .code(2)
+            .stderr(contains(says));
+        assert_eq!(fs::read(log.join("summary.json")).unwrap(), before);
+    }
+    // The world's own sweep is accepted, and maps as the world does.
+    swarmmap()
+        .args(["map", "--world", TINY, "--sweep", "0.02"])
+        .arg(&log)
+        .assert()
+        .success();
+    assert_eq!(json(&log.join("maps/window_1.json"))["outlier_rank"], 2);
+}
+
 /// A static interval far beyond the encounters (a mistyped end) stretches the windows: the
 /// empty window is warned about, and a cluster that reaches only one map is no connection
 /// (found by the fortieth session's review: "connections 1–2: 1" was printed beside an

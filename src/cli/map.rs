@@ -44,6 +44,12 @@ pub struct MapArgs {
     /// "Commands" gives them). The windows are cut with --windows and --overlap instead.
     #[arg(long = "set", value_name = "mapping.FIELD=VALUE")]
     pub set: Vec<String>,
+    /// The leader's sweep speed the log was recorded at, m/s (default: the world's
+    /// `leader.speed`; without a world, the paper's 0.005). It picks the classifier's
+    /// models fitted nearest it and scales the outlier filter's neighbour rank; a world
+    /// fixes it, so with one it may only repeat the world's.
+    #[arg(long, value_name = "M_PER_S", allow_negative_numbers = true)]
+    pub sweep: Option<f64>,
 }
 
 /// `--method` values.
@@ -120,6 +126,52 @@ fn mapping_sets(args: &MapArgs) -> Result<MappingParams, Failure> {
     Ok(spec.check().map_err(input)?.mapping)
 }
 
+/// The sweep speed the log is mapped at: `--sweep`, else the world's, else the paper's. A
+/// world fixes the sweep (its leader moved the domain the log was recorded in), so a
+/// `--sweep` that differs from it is refused rather than silently preferred.
+fn sweep_of(args: &MapArgs, world: Option<&swarmmap::world::World>) -> Result<f64, Failure> {
+    let Some(v) = args.sweep else {
+        return Ok(
+            world.map_or(swarmmap::mapping::classify::DEFAULT_SWEEP, |w| {
+                w.leader.speed
+            }),
+        );
+    };
+    if !(v.is_finite() && v > 0.0) {
+        return Err(input(anyhow::anyhow!(
+            "--sweep is {}; it is the leader's sweep speed in m/s, a positive number (the \
+             paper's is {})",
+            swarmmap::world::given(v),
+            swarmmap::mapping::classify::DEFAULT_SWEEP
+        )));
+    }
+    if let Some(w) = world
+        && v != w.leader.speed
+    {
+        let (whose, fix) = match &args.world {
+            Some(path) => (
+                format!("the world {}", path.display()),
+                "drop --sweep, or correct the world's leader.speed",
+            ),
+            None => (
+                format!(
+                    "the run's world ({})",
+                    args.run_dir.join("meta.json").display()
+                ),
+                "drop --sweep (the run recorded the sweep it was simulated at), or judge the \
+                 log against another world with --world",
+            ),
+        };
+        return Err(input(anyhow::anyhow!(
+            "--sweep is {} m/s, but {whose} sweeps at {} m/s (its leader.speed), and the \
+             world fixes the sweep; {fix}",
+            swarmmap::world::given(v),
+            swarmmap::world::given(w.leader.speed)
+        )));
+    }
+    Ok(v)
+}
+
 pub fn run(args: &MapArgs) -> Result<(), Failure> {
     let mut timings = Timings::default();
     let (log, notes) = timings
@@ -145,6 +197,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         }
         None => None,
     };
+    let sweep = sweep_of(args, world.as_ref())?;
     let (mut cfg, stitch) = match &world {
         Some(w) => (
             MapConfig::for_world(w),
@@ -166,7 +219,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
                     windows: m.windows,
                     overlap: m.overlap,
                     span,
-                    local: LocalParams::from_mapping(&m),
+                    local: LocalParams::from_mapping_at(&m, sweep),
                 },
                 StitchParams {
                     cutoff: m.cluster_cutoff,
@@ -281,11 +334,6 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
             .as_ref()
             .map_or_else(|| defaults.clone(), |w| w.mapping.clone());
         m.method = method.into();
-        let sweep = world
-            .as_ref()
-            .map_or(swarmmap::mapping::classify::DEFAULT_SWEEP, |w| {
-                w.leader.speed
-            });
         cfg.local = LocalParams::from_mapping_at(&m, sweep);
     }
     if !log

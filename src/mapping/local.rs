@@ -236,6 +236,10 @@ pub struct LocalMap {
     /// The thresholds the window was judged by: the model of `LocalParams::classifier`
     /// fitted nearest `events_per_point`.
     pub classifier: Classifier,
+    /// The outlier filter's neighbour rank k the representatives were picked with
+    /// (`LocalParams::subsample.k`, scaled with the sweep:
+    /// [`super::subsample::rank_for_sweep`]).
+    pub outlier_rank: usize,
     /// Distance rows from each component's representatives, kept for fidelity and
     /// stitching: `(event index, row over the window's events)`.
     #[serde(skip)]
@@ -602,6 +606,7 @@ pub fn local_map_with(
         explained,
         events_per_point,
         classifier,
+        outlier_rank: p.subsample.k,
         rows: rows_out,
     }
 }

@@ -122,12 +122,16 @@ struct WindowOut<'a> {
     events_per_point: f64,
     /// The classifier's thresholds the diagrams were judged with (see `classify.rs`).
     classifier: Classifier,
+    /// The outlier filter's neighbour rank k the representatives were picked with (it
+    /// scales with the leader's sweep: `subsample::rank_for_sweep`).
+    outlier_rank: usize,
     events: Vec<EventOut>,
     components: &'a [super::local::Component],
 }
 
 /// The JSON text of `maps/window_<i>.json`, with the thresholds of the classifier the
-/// diagrams were judged with (the report draws them) and the density that picked them.
+/// diagrams were judged with (the report draws them), the density that picked them, and
+/// the outlier filter's neighbour rank.
 pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>) -> String {
     let events = map
         .events
@@ -156,6 +160,7 @@ pub fn window_json(map: &LocalMap, log: &EncounterLog, truth: Option<[usize; 2]>
         explained: map.explained,
         events_per_point: map.events_per_point,
         classifier: map.classifier,
+        outlier_rank: map.outlier_rank,
         events,
         components: &map.components,
     };

@@ -249,6 +249,7 @@ mod oracle_tests {
             betti: [1, 0],
             explained: 1.0,
             events_per_point: 1.0,
+            outlier_rank: 8,
             classifier: crate::mapping::classify::Classifier::default(),
             rows: Vec::new(),
         };

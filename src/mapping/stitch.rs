@@ -801,6 +801,7 @@ mod tests {
             betti: [1, 1],
             explained: 1.0,
             events_per_point: 1.0,
+            outlier_rank: 8,
             // The shipped Embedded model's thresholds: a hole is strong from a life of
             // 1.25 · 4.25 · σ = 0.53.
             classifier: crate::mapping::classify::Classifier {
