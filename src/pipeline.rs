@@ -624,6 +624,57 @@ pub fn run_world(
     Ok((out, mapped))
 }
 
+/// Whether two worlds simulate alike: they differ in nothing but their `mapping` section,
+/// which the simulator never reads (it only copies it into `meta.json`).
+pub fn same_simulation(a: &World, b: &World) -> bool {
+    World {
+        mapping: b.mapping.clone(),
+        ..a.clone()
+    } == *b
+}
+
+/// Simulates the first of `worlds` once (without writing it) and maps its log with each
+/// of them, in parallel on the current rayon pool: what [`run_world`] with
+/// [`Alongside::Off`] gives for each world, summary for summary, but with one simulation
+/// instead of one per world. Every world must [simulate alike](same_simulation) (an
+/// evaluation campaign that sweeps `mapping.*` settings); each summary's `timings` holds
+/// the one simulation's time. The outer error is the simulation's, shared by every world.
+pub fn run_world_variants(
+    worlds: &[World],
+    seed: u64,
+) -> Result<Vec<Result<Summary, PipelineError>>, PipelineError> {
+    let Some(first) = worlds.first() else {
+        return Ok(Vec::new());
+    };
+    debug_assert!(worlds.iter().all(|w| same_simulation(first, w)));
+    let mut timings = Timings::default();
+    let out = timings.time("simulation", || simulate(first, &SimOptions::new(seed)))?;
+    Ok(worlds
+        .par_iter()
+        .map(|world| {
+            let cfg = MapConfig::for_world(world);
+            let stitch = StitchParams {
+                cutoff: world.mapping.cluster_cutoff,
+                neighbours: world.mapping.neighbours,
+            };
+            let windows = cfg.windows();
+            let mut timings = timings.clone();
+            let done = Partial::new(windows.len());
+            finish(
+                &out.log,
+                Some(world),
+                &cfg,
+                &stitch,
+                Some(seed),
+                &windows,
+                done,
+                &mut timings,
+            )
+            .map(|m| m.summary)
+        })
+        .collect())
+}
+
 /// Runs the simulation on this thread while a worker with a pool of `threads` threads
 /// maps each window's prefix ([`run_world`], "Mapping while the simulation runs");
 /// with `lockstep` ([`Alongside::Lockstep`]) the simulation waits at each cut until the
@@ -789,4 +840,28 @@ fn map_prefixes(
         done.maps[k] = Some(map);
     }
     (done, busy)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only the mapping section may differ between worlds that share a simulation.
+    #[test]
+    fn worlds_simulate_alike_when_only_their_mapping_differs() {
+        let base = World::empty("w", 6.0, 3.0);
+        let mut mapping = base.clone();
+        mapping.mapping.cluster_cutoff = 20.0;
+        mapping.mapping.windows = base.mapping.windows + 1;
+        assert!(same_simulation(&base, &mapping) && same_simulation(&mapping, &base));
+        let mut agents = base.clone();
+        agents.swarm.agents += 1;
+        let mut seed = base.clone();
+        seed.seed += 1;
+        let mut leader = mapping.clone();
+        leader.leader.speed *= 2.0;
+        for other in [&agents, &seed, &leader] {
+            assert!(!same_simulation(&base, other), "{other:?}");
+        }
+    }
 }

@@ -793,6 +793,67 @@ fn eval_writes_one_row_per_run_and_resumes() {
         .stderr(contains("agentz"));
 }
 
+/// The stored runs of an `eval` into `out`, by (params, seed).
+fn stored_runs(out: &Path) -> std::collections::BTreeMap<(String, u64), serde_json::Value> {
+    fs::read_dir(out.join("runs"))
+        .unwrap()
+        .map(|e| {
+            let rec = json(&e.unwrap().path());
+            let key = (
+                rec["params"].as_str().unwrap().to_string(),
+                rec["seed"].as_u64().unwrap(),
+            );
+            (key, rec)
+        })
+        .collect()
+}
+
+/// A sweep of mapping settings simulates each seed once (the variants of a seed carry the
+/// one simulation's time) and scores every variant exactly as a campaign of that variant
+/// alone, which simulates for itself.
+#[test]
+fn eval_shares_one_simulation_among_mapping_variants() {
+    let tmp = tempfile::tempdir().unwrap();
+    let eval = |dir: &str, cutoffs: &str| {
+        let out = tmp.path().join(dir);
+        swarmmap()
+            .args([
+                "eval", TINY, "--seeds", "1,2", "--jobs", "2", "--quiet", "--set",
+            ])
+            .arg(format!("mapping.cluster_cutoff={cutoffs}"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        stored_runs(&out)
+    };
+    let swept = eval("swept", "20,50");
+    assert_eq!(swept.len(), 4, "{:?}", swept.keys());
+    let without_timings = |rec: &serde_json::Value| {
+        let mut s = rec["summary"].clone();
+        s.as_object_mut().unwrap().remove("timings");
+        s
+    };
+    let key = |cutoff: &str, seed: u64| (format!("mapping.cluster_cutoff={cutoff}"), seed);
+    for seed in [1, 2] {
+        let (a, b) = (&swept[&key("20", seed)], &swept[&key("50", seed)]);
+        assert_eq!(
+            a["summary"]["timings"]["simulation"], b["summary"]["timings"]["simulation"],
+            "seed {seed}: the two cut-offs share one simulation"
+        );
+    }
+    for cutoff in ["20", "50"] {
+        let own = eval(&format!("alone{cutoff}"), cutoff);
+        for seed in [1, 2] {
+            assert_eq!(
+                without_timings(&swept[&key(cutoff, seed)]),
+                without_timings(&own[&key(cutoff, seed)]),
+                "seed {seed}, cut-off {cutoff}"
+            );
+        }
+    }
+}
+
 /// The shipped model file with every method's thresholds replaced.
 fn model_file(dir: &Path, name: &str, h1_ratio: f64, h1_span: f64) -> std::path::PathBuf {
     let mut m = json(Path::new("assets/classifier.json"));

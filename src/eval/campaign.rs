@@ -11,8 +11,8 @@
 
 use crate::io::write_atomic;
 use crate::mapping::output::Summary;
-use crate::pipeline::{Alongside, RunOptions, run_world};
-use crate::world::{WorldSpec, apply_override};
+use crate::pipeline::{run_world_variants, same_simulation};
+use crate::world::{World, WorldSpec, apply_override};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -140,28 +140,21 @@ pub struct RunRecord {
     pub build: Option<String>,
 }
 
-fn run_one(job: &Job, text: &str) -> RunRecord {
+/// A job's world: its file's text with the job's overrides and seed, checked; on failure
+/// the error, and the world's name when it is known by then.
+fn job_world(job: &Job, text: &str) -> Result<World, (Option<String>, String)> {
     let name = job.world.display().to_string();
-    // The world's name labels the run, failed or not, as soon as the world is known.
-    let mut label = None;
-    let result = (|| -> Result<Summary, String> {
-        let mut spec = crate::world::parse_str(text, &name).map_err(|e| e.to_string())?;
-        for (p, v) in &job.overrides {
-            apply_override(&mut spec, p, v).map_err(|e| e.to_string())?;
-        }
-        apply_override(&mut spec, "seed", &job.seed.to_string()).map_err(|e| e.to_string())?;
-        let world = WorldSpec::check(spec).map_err(|e| e.to_string())?;
-        label = Some(world.name.clone());
-        let opts = RunOptions {
-            seed: job.seed,
-            out: None,
-            trajectories: None,
-            progress: None,
-            alongside: Alongside::Off,
-        };
-        let (_, mapped) = run_world(&world, &opts).map_err(|e| e.to_string())?;
-        Ok(mapped.summary)
-    })();
+    let mut spec = crate::world::parse_str(text, &name).map_err(|e| (None, e.to_string()))?;
+    for (p, v) in &job.overrides {
+        apply_override(&mut spec, p, v).map_err(|e| (None, e.to_string()))?;
+    }
+    apply_override(&mut spec, "seed", &job.seed.to_string()).map_err(|e| (None, e.to_string()))?;
+    WorldSpec::check(spec).map_err(|e| (None, e.to_string()))
+}
+
+/// The record of `job`, labelled by its world's name (`label`, else the file's stem).
+fn record(job: &Job, label: Option<String>, result: Result<Summary, String>) -> RunRecord {
+    let name = job.world.display().to_string();
     let world = label.unwrap_or_else(|| {
         job.world
             .file_stem()
@@ -169,32 +162,39 @@ fn run_one(job: &Job, text: &str) -> RunRecord {
             .unwrap_or("world")
             .to_string()
     });
-    match result {
-        Ok(s) => RunRecord {
-            world: s.world.clone(),
-            world_file: name,
-            params: job.params(),
-            seed: job.seed,
-            summary: serde_json::to_value(&s).ok(),
-            error: None,
-            build: None,
-        },
-        Err(e) => RunRecord {
-            world,
-            world_file: name,
-            params: job.params(),
-            seed: job.seed,
-            summary: None,
-            error: Some(e),
-            build: None,
-        },
+    let (summary, error) = match result {
+        Ok(s) => (serde_json::to_value(&s).ok(), None),
+        Err(e) => (None, Some(e)),
+    };
+    RunRecord {
+        world,
+        world_file: name,
+        params: job.params(),
+        seed: job.seed,
+        summary,
+        error,
+        build: None,
     }
+}
+
+/// Jobs to run that simulate alike ([`same_simulation`]): one simulation, mapped once per
+/// job ([`run_world_variants`]).
+struct SimGroup<'a> {
+    seed: u64,
+    /// Each job, where its record goes, and its world.
+    members: Vec<(&'a Job, PathBuf, World)>,
 }
 
 /// Runs every job not yet recorded in `dir/runs/`, `jobs` at a time, calling `tick`
 /// after each; returns all records (old and new) sorted by world, params, seed. With
 /// `build` (this build, [`build_id`]), a run recorded by another build, or by none, counts
 /// as not recorded and is run again; with `None`, any recorded run is reused.
+///
+/// Jobs that differ only in `mapping.*` settings (same world file, seed and other
+/// overrides) share one simulation: the simulator reads no mapping setting, so each job's
+/// summary is the one its own simulation would give, and a sweep of mapping settings costs
+/// one simulation per seed, not one per value. Their `timings` each hold that simulation's
+/// time.
 pub fn run_campaign(
     jobs: &[Job],
     dir: &Path,
@@ -211,33 +211,75 @@ pub fn run_campaign(
         }
     }
     let models = models_part();
+    let store = |rec: RunRecord, path: &Path| -> std::io::Result<RunRecord> {
+        let rec = RunRecord {
+            build: build.map(String::from),
+            ..rec
+        };
+        let mut bytes = serde_json::to_vec_pretty(&rec).map_err(std::io::Error::other)?;
+        bytes.push(b'\n');
+        write_atomic(path, &bytes)?;
+        tick(&rec);
+        Ok(rec)
+    };
+    let mut out = Vec::new();
+    let mut groups: Vec<SimGroup> = Vec::new();
+    for job in jobs {
+        let text = &texts[&job.world];
+        let path = runs.join(format!("{}.json", job.key(text, models.as_deref())));
+        if let Ok(old) = std::fs::read_to_string(&path)
+            && let Ok(rec) = serde_json::from_str::<RunRecord>(&old)
+            && (build.is_none() || rec.build.as_deref() == build)
+        {
+            tick(&rec);
+            out.push(rec);
+            continue;
+        }
+        match job_world(job, text) {
+            Err((label, e)) => out.push(store(record(job, label, Err(e)), &path)?),
+            Ok(world) => {
+                let shared = groups
+                    .iter_mut()
+                    .find(|g| g.seed == job.seed && same_simulation(&g.members[0].2, &world));
+                match shared {
+                    Some(g) => g.members.push((job, path, world)),
+                    None => groups.push(SimGroup {
+                        seed: job.seed,
+                        members: vec![(job, path, world)],
+                    }),
+                }
+            }
+        }
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.clamp(1, jobs.len().max(1)))
         .build()
         .map_err(std::io::Error::other)?;
     let records: Vec<std::io::Result<RunRecord>> = pool.install(|| {
-        jobs.par_iter()
-            .map(|job| {
-                let text = &texts[&job.world];
-                let path = runs.join(format!("{}.json", job.key(text, models.as_deref())));
-                if let Ok(old) = std::fs::read_to_string(&path)
-                    && let Ok(rec) = serde_json::from_str::<RunRecord>(&old)
-                    && (build.is_none() || rec.build.as_deref() == build)
-                {
-                    tick(&rec);
-                    return Ok(rec);
-                }
-                let mut rec = run_one(job, text);
-                rec.build = build.map(String::from);
-                let mut bytes = serde_json::to_vec_pretty(&rec).map_err(std::io::Error::other)?;
-                bytes.push(b'\n');
-                write_atomic(&path, &bytes)?;
-                tick(&rec);
-                Ok(rec)
+        groups
+            .par_iter()
+            .flat_map_iter(|g| {
+                let worlds: Vec<World> = g.members.iter().map(|(_, _, w)| w.clone()).collect();
+                let results = match run_world_variants(&worlds, g.seed) {
+                    Ok(results) => results
+                        .into_iter()
+                        .map(|r| r.map_err(|e| e.to_string()))
+                        .collect(),
+                    Err(e) => vec![Err(e.to_string()); worlds.len()],
+                };
+                g.members
+                    .iter()
+                    .zip(results)
+                    .map(|((job, path, world), result)| {
+                        store(record(job, Some(world.name.clone()), result), path)
+                    })
+                    .collect::<Vec<_>>()
             })
             .collect()
     });
-    let mut out = records.into_iter().collect::<std::io::Result<Vec<_>>>()?;
+    for rec in records {
+        out.push(rec?);
+    }
     out.sort_by(|a, b| {
         (a.world_file.as_str(), a.params.as_str(), a.seed).cmp(&(
             b.world_file.as_str(),
