@@ -448,6 +448,13 @@ fn map_sweep_picks_the_rank_and_models_of_a_worldless_log() {
         (&["--sweep", "0.005"][..], 8, false),
         (&["--sweep", "0.02"][..], 2, true),
         (&["--sweep", "0.0025"][..], 16, false),
+        // A rank set in the mapping settings holds whatever the sweep.
+        (
+            &["--sweep", "0.0025", "--set", "mapping.outlier_rank=5"][..],
+            5,
+            false,
+        ),
+        (&["--set", "mapping.outlier_rank=5"][..], 5, false),
     ] {
         for w in windows(extra) {
             assert_eq!(w["outlier_rank"], rank, "{extra:?}");

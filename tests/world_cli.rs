@@ -37,6 +37,8 @@ fn check_prints_a_summary_of_each_scenario() {
             4800,
         ),
     ] {
+        // The outlier filter's rank scales with the sweep: 8 at 0.005 m/s, 16 at 0.0025.
+        let rank = if speed == "0.0025" { 16 } else { 8 };
         swarmmap()
             .args(["check", file])
             .assert()
@@ -56,7 +58,7 @@ fn check_prints_a_summary_of_each_scenario() {
             .stdout(predicate::str::contains(format!("W{windows} ")))
             .stdout(predicate::str::contains(format!("W{} ", windows + 1)).not())
             .stdout(predicate::str::contains(format!(
-                "mapping    Embedded method, switch cost 1 s, c = 35, m = 400, k = 5; \
+                "mapping    Embedded method, switch cost 1 s, c = 35, m = 400, outlier rank {rank} (from the sweep), k = 5; \
                  encounters after the first landmark; weights between encounter middles; \
                  {rips} planar Rips points"
             )));
@@ -77,7 +79,7 @@ fn check_summarises_the_paper_mapping_without_rips_points() {
         .assert()
         .success()
         .stdout(predicate::str::contains(
-            "mapping    Paper method, switch cost 1 s, c = 35, m = 400, k = 5; \
+            "mapping    Paper method, switch cost 1 s, c = 35, m = 400, outlier rank 8 (from the sweep), k = 5; \
              every encounter; the paper's interval-gap weights\n",
         ));
 }

@@ -314,6 +314,8 @@ fn meaningless_numbers_are_rejected_everywhere() {
         ("mapping.neighbours", "-1", "must be at least 0"),
         ("mapping.rips_points", "49", "must be at least 50"),
         ("mapping.rips_points", "100001", "must be at most 100000"),
+        ("mapping.outlier_rank", "0", "must be at least 1"),
+        ("mapping.outlier_rank", "801", "must be at most 800"),
         ("mapping.switch_cost", "-1.0", "must be ≥ 0 seconds"),
         ("mapping.switch_cost", "inf", "must be a finite number"),
         ("swarm.agents", "-5", "must be at least 1"),
@@ -773,6 +775,24 @@ fn encounter_midpoints_is_off_unless_asked() {
         valid_with("mapping.encounter_midpoints", "true")
             .mapping
             .encounter_midpoints
+    );
+}
+
+/// Left out, the outlier rank scales with the sweep (the mapping decides, not the check);
+/// set in the file or with `--set`, it is kept, and written back into `meta.json`'s world.
+#[test]
+fn outlier_rank_is_unset_by_default_and_can_be_set() {
+    assert_eq!(check_text("()").expect("valid").mapping.outlier_rank, None);
+    let w = check_text("(mapping: (outlier_rank: 12))").expect("valid");
+    assert_eq!(w.mapping.outlier_rank, Some(12));
+    let w = valid_with("mapping.outlier_rank", "3");
+    assert_eq!(w.mapping.outlier_rank, Some(3));
+    let meta = swarmmap::sim::world_json(&w);
+    assert_eq!(meta["mapping"]["outlier_rank"], 3);
+    assert!(
+        swarmmap::sim::world_json(&check_text("()").unwrap())["mapping"]
+            .get("outlier_rank")
+            .is_none()
     );
 }
 

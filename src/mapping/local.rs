@@ -111,11 +111,15 @@ impl LocalParams {
 
     /// The parameters a world's `mapping` section selects for a leader sweeping at `sweep`
     /// m/s: the models of the method fitted at the nearest sweep
-    /// ([`super::classify::Bank::for_sweep`]).
+    /// ([`super::classify::Bank::for_sweep`]), and the outlier filter's neighbour rank the
+    /// section gives (`outlier_rank`), else the one scaled with the sweep
+    /// ([`super::subsample::rank_for_sweep`]).
     pub fn from_mapping_at(m: &crate::world::MappingParams, sweep: f64) -> Self {
         let mut p = Self::default();
         p.subsample.m = m.subsample;
-        p.subsample.k = super::subsample::rank_for_sweep(sweep);
+        p.subsample.k = m
+            .outlier_rank
+            .unwrap_or_else(|| super::subsample::rank_for_sweep(sweep));
         p.classifier = super::classify::Models::active()
             .get(m.method)
             .for_sweep(sweep);
@@ -856,5 +860,18 @@ mod tests {
         assert_eq!(p, super::super::dense::DenseParams::embedded_with(2400));
         m.method = crate::world::MappingMethod::Paper;
         assert!(LocalParams::from_mapping(&m).embedding_rips.is_none());
+    }
+
+    /// The outlier rank scales with the sweep unless the mapping settings fix it.
+    #[test]
+    fn outlier_rank_follows_the_sweep_unless_set() {
+        let mut m = crate::world::MappingParams::default();
+        for (sweep, k) in [(0.005, 8), (0.0025, 16), (0.02, 2)] {
+            assert_eq!(LocalParams::from_mapping_at(&m, sweep).subsample.k, k);
+        }
+        m.outlier_rank = Some(12);
+        for sweep in [0.005, 0.0025, 0.02] {
+            assert_eq!(LocalParams::from_mapping_at(&m, sweep).subsample.k, 12);
+        }
     }
 }

@@ -151,6 +151,9 @@ pub fn world_json(world: &World) -> Value {
     if m.split_stability {
         v["mapping"]["split_stability"] = json!(true);
     }
+    if let Some(k) = m.outlier_rank {
+        v["mapping"]["outlier_rank"] = json!(k);
+    }
     if m.rips_points != crate::mapping::dense::EMBEDDED_POINTS {
         v["mapping"]["rips_points"] = json!(m.rips_points);
     }

@@ -799,6 +799,19 @@ impl WorldSpec {
             100_000,
             "use 50 to 100000 points, e.g. 1200 (the Embedded method's default)",
         )?;
+        let outlier_rank = m
+            .outlier_rank
+            .map(|k| {
+                ctx.count(
+                    "mapping.outlier_rank",
+                    k,
+                    1,
+                    crate::mapping::subsample::MAX_RANK,
+                    "use a neighbour rank from 1 to 800, or leave it out to scale it with the \
+                     leader's sweep (8 at the paper's 0.005 m/s)",
+                )
+            })
+            .transpose()?;
         let method = match m.method {
             None | Some(MethodSpec::Paper) => MappingMethod::Paper,
             Some(MethodSpec::Embedded) => MappingMethod::Embedded,
@@ -816,6 +829,7 @@ impl WorldSpec {
             rips_points,
             agent_timelines: m.agent_timelines.unwrap_or(md.agent_timelines),
             split_stability: m.split_stability.unwrap_or(md.split_stability),
+            outlier_rank,
         };
 
         let world = World {

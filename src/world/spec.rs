@@ -153,6 +153,7 @@ pub struct MappingSpec {
     pub encounter_midpoints: Option<bool>,
     pub rips_points: Option<i64>,
     pub agent_timelines: Option<bool>,
+    pub outlier_rank: Option<i64>,
     pub split_stability: Option<bool>,
 }
 
@@ -482,6 +483,7 @@ pub const SETTING_PATHS: &[&str] = &[
     "mapping.rips_points",
     "mapping.agent_timelines",
     "mapping.split_stability",
+    "mapping.outlier_rank",
 ];
 
 /// Parses `value` as RON of the slot's type and stores it. As in a world file, the value
@@ -672,6 +674,7 @@ impl WorldSpec {
                             "rips_points" => put(&mut s.rips_points, p, v)?,
                             "agent_timelines" => put(&mut s.agent_timelines, p, v)?,
                             "split_stability" => put(&mut s.split_stability, p, v)?,
+                            "outlier_rank" => put(&mut s.outlier_rank, p, v)?,
                             _ => return Err(unknown_setting(path)),
                         }
                     }

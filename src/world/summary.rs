@@ -170,11 +170,18 @@ impl World {
         let m = &self.mapping;
         let _ = writeln!(
             s,
-            "mapping    {:?} method, switch cost {} s, c = {}, m = {}, k = {}; {}; {}{}",
+            "mapping    {:?} method, switch cost {} s, c = {}, m = {}, outlier rank {}, k = {}; {}; {}{}",
             m.method,
             given(m.switch_cost),
             given(m.cluster_cutoff),
             m.subsample,
+            match m.outlier_rank {
+                Some(k) => k.to_string(),
+                None => format!(
+                    "{} (from the sweep)",
+                    crate::mapping::subsample::rank_for_sweep(self.leader.speed)
+                ),
+            },
             m.neighbours,
             if m.after_landmarks {
                 "encounters after the first landmark"

@@ -187,6 +187,10 @@ pub struct MappingParams {
     /// with one always gets them; default: `false`). For fitting one: `swarmmap calibrate
     /// --stability`.
     pub split_stability: bool,
+    /// Neighbour rank k of the subsampling's outlier filter (`mapping::subsample`; default:
+    /// `None`, k scaled with the leader's sweep: `subsample::rank_for_sweep`, 8 at the
+    /// paper's 0.005 m/s).
+    pub outlier_rank: Option<usize>,
 }
 
 impl Default for MappingParams {
@@ -204,6 +208,7 @@ impl Default for MappingParams {
             rips_points: crate::mapping::dense::EMBEDDED_POINTS,
             agent_timelines: false,
             split_stability: false,
+            outlier_rank: None,
         }
     }
 }
