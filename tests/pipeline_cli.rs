@@ -861,6 +861,30 @@ fn eval_shares_one_simulation_among_mapping_variants() {
     }
 }
 
+/// Two parameter sets that give one world (a world without obstacles scaled, a value
+/// written twice) are warned of, and their runs are made once: both records hold the same
+/// summary, timings included.
+#[test]
+fn eval_warns_of_parameter_sets_that_give_one_world_and_runs_it_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("eval");
+    swarmmap()
+        .args(["eval", TINY, "--seeds", "1", "--quiet"])
+        .args(["--set", "mapping.cluster_cutoff=50,50.0", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stderr(contains(
+            "`--set mapping.cluster_cutoff=50` and `--set mapping.cluster_cutoff=50.0` give \
+             the same world",
+        ));
+    let runs = stored_runs(&out);
+    let summaries: Vec<_> = runs.values().map(|r| r["summary"].clone()).collect();
+    assert_eq!(summaries.len(), 2);
+    assert!(summaries[0].is_object(), "{:?}", summaries[0]);
+    assert_eq!(summaries[0], summaries[1]);
+}
+
 /// The shipped model file with every method's thresholds replaced.
 fn model_file(dir: &Path, name: &str, h1_ratio: f64, h1_span: f64) -> std::path::PathBuf {
     let mut m = json(Path::new("assets/classifier.json"));

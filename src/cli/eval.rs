@@ -160,12 +160,34 @@ pub fn run(args: &EvalArgs) -> Result<(), Failure> {
     // row, their seeds paired as one world's.
     let mut names: std::collections::BTreeMap<String, &std::path::PathBuf> = Default::default();
     for w in &args.worlds {
+        // Two parameter sets that give one world (an `obstacles.scale` of a world without
+        // obstacles, `50` and `50.0`) get the same runs, made once (`run_campaign`) and
+        // shown under both sets: said, since it is rarely what was meant.
+        let mut made: Vec<(swarmmap::world::World, &Vec<(String, String)>)> = Vec::new();
         for c in &combos {
             let mut spec = WorldSpec::load(w).map_err(input)?;
             for (p, v) in c {
                 swarmmap::world::apply_override(&mut spec, p, v).map_err(input)?;
             }
             let world = spec.check().map_err(input)?;
+            if let Some((_, earlier)) = made.iter().find(|(other, _)| *other == world) {
+                let show = |c: &[(String, String)]| {
+                    c.iter()
+                        .map(|(p, v)| format!("--set {p}={v}"))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                eprintln!(
+                    "warning: {}: `{}` and `{}` give the same world (a value that changes \
+                     nothing here, such as obstacles.scale on a world without obstacles, or \
+                     one written twice, as 50 and 50.0); its runs are made once and shown \
+                     under both",
+                    w.display(),
+                    show(earlier),
+                    show(c)
+                );
+            }
+            made.push((world.clone(), c));
             if let Some(first) = names.insert(world.name.clone(), w)
                 && first != w
             {

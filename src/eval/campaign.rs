@@ -194,7 +194,7 @@ struct SimGroup<'a> {
 /// overrides) share one simulation: the simulator reads no mapping setting, so each job's
 /// summary is the one its own simulation would give, and a sweep of mapping settings costs
 /// one simulation per seed, not one per value. Their `timings` each hold that simulation's
-/// time.
+/// time. Jobs whose parameter sets give the very same world share their mapping too.
 pub fn run_campaign(
     jobs: &[Job],
     dir: &Path,
@@ -259,19 +259,34 @@ pub fn run_campaign(
         groups
             .par_iter()
             .flat_map_iter(|g| {
-                let worlds: Vec<World> = g.members.iter().map(|(_, _, w)| w.clone()).collect();
-                let results = match run_world_variants(&worlds, g.seed) {
-                    Ok(results) => results
-                        .into_iter()
-                        .map(|r| r.map_err(|e| e.to_string()))
-                        .collect(),
-                    Err(e) => vec![Err(e.to_string()); worlds.len()],
-                };
+                // Parameter sets that give one world (`eval` warns of them) are mapped once.
+                let mut worlds: Vec<World> = Vec::new();
+                let which: Vec<usize> = g
+                    .members
+                    .iter()
+                    .map(|(_, _, w)| {
+                        worlds.iter().position(|u| u == w).unwrap_or_else(|| {
+                            worlds.push(w.clone());
+                            worlds.len() - 1
+                        })
+                    })
+                    .collect();
+                let results: Vec<Result<Summary, String>> =
+                    match run_world_variants(&worlds, g.seed) {
+                        Ok(results) => results
+                            .into_iter()
+                            .map(|r| r.map_err(|e| e.to_string()))
+                            .collect(),
+                        Err(e) => vec![Err(e.to_string()); worlds.len()],
+                    };
                 g.members
                     .iter()
-                    .zip(results)
-                    .map(|((job, path, world), result)| {
-                        store(record(job, Some(world.name.clone()), result), path)
+                    .zip(which)
+                    .map(|((job, path, world), u)| {
+                        store(
+                            record(job, Some(world.name.clone()), results[u].clone()),
+                            path,
+                        )
                     })
                     .collect::<Vec<_>>()
             })
