@@ -2,7 +2,8 @@
 //! world → simulation → encounter log → local maps → global map → evaluation, each timed.
 //!
 //! `swarmmap run` calls [`run_world`]; `swarmmap map` calls [`map_log`] on a log read from
-//! disk; `swarmmap eval` calls [`run_world`] for many worlds and seeds in parallel.
+//! disk; `swarmmap eval` calls [`run_world_variants`] for many worlds and seeds in parallel
+//! (one simulation for the runs that differ only in their mapping settings).
 
 use crate::eval::truth::{FreeSpace, TruthError, overlap, window_band};
 use crate::io::{is_numbered_map, remove_stale, write_atomic};
@@ -514,8 +515,9 @@ pub struct RunOptions<'a> {
 /// How [`run_world`] maps while the simulation runs ("Mapping while the simulation runs").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Alongside {
-    /// Simulate, then map every window from the final log. `swarmmap eval`, which runs
-    /// many simulations side by side, and `swarmmap run --map-after` use this.
+    /// Simulate, then map every window from the final log. `swarmmap run --map-after`
+    /// uses this, and `swarmmap eval`, which runs many simulations side by side, does the
+    /// same through [`run_world_variants`].
     Off,
     /// Map each window on the other cores as soon as its part of the log is final; the
     /// simulation never waits, so a prefix that comes while another still waits for the
@@ -636,43 +638,51 @@ pub fn same_simulation(a: &World, b: &World) -> bool {
 /// Simulates the first of `worlds` once (without writing it) and maps its log with each
 /// of them, in parallel on the current rayon pool: what [`run_world`] with
 /// [`Alongside::Off`] gives for each world, summary for summary, but with one simulation
-/// instead of one per world. Every world must [simulate alike](same_simulation) (an
-/// evaluation campaign that sweeps `mapping.*` settings); each summary's `timings` holds
-/// the one simulation's time. The outer error is the simulation's, shared by every world.
+/// instead of one per world. Each summary is handed to `done` with its world's index as
+/// soon as it is ready (so that a campaign stores it at once); its `timings` hold the one
+/// simulation's time. The error is the simulation's, shared by every world (none is then
+/// handed to `done`).
+///
+/// # Panics
+///
+/// When two of `worlds` do not [simulate alike](same_simulation): one world's log would
+/// be judged against another's truth.
 pub fn run_world_variants(
     worlds: &[World],
     seed: u64,
-) -> Result<Vec<Result<Summary, PipelineError>>, PipelineError> {
+    done: &(dyn Fn(usize, Result<Summary, PipelineError>) + Sync),
+) -> Result<(), PipelineError> {
     let Some(first) = worlds.first() else {
-        return Ok(Vec::new());
+        return Ok(());
     };
-    debug_assert!(worlds.iter().all(|w| same_simulation(first, w)));
+    assert!(
+        worlds.iter().all(|w| same_simulation(first, w)),
+        "run_world_variants: worlds that differ beyond their mapping settings"
+    );
     let mut timings = Timings::default();
     let out = timings.time("simulation", || simulate(first, &SimOptions::new(seed)))?;
-    Ok(worlds
-        .par_iter()
-        .map(|world| {
-            let cfg = MapConfig::for_world(world);
-            let stitch = StitchParams {
-                cutoff: world.mapping.cluster_cutoff,
-                neighbours: world.mapping.neighbours,
-            };
-            let windows = cfg.windows();
-            let mut timings = timings.clone();
-            let done = Partial::new(windows.len());
-            finish(
-                &out.log,
-                Some(world),
-                &cfg,
-                &stitch,
-                Some(seed),
-                &windows,
-                done,
-                &mut timings,
-            )
-            .map(|m| m.summary)
-        })
-        .collect())
+    worlds.par_iter().enumerate().for_each(|(i, world)| {
+        let cfg = MapConfig::for_world(world);
+        let stitch = StitchParams {
+            cutoff: world.mapping.cluster_cutoff,
+            neighbours: world.mapping.neighbours,
+        };
+        let windows = cfg.windows();
+        let mut timings = timings.clone();
+        let partial = Partial::new(windows.len());
+        let mapped = finish(
+            &out.log,
+            Some(world),
+            &cfg,
+            &stitch,
+            Some(seed),
+            &windows,
+            partial,
+            &mut timings,
+        );
+        done(i, mapped.map(|m| m.summary));
+    });
+    Ok(())
 }
 
 /// Runs the simulation on this thread while a worker with a pool of `threads` threads
@@ -863,5 +873,52 @@ mod tests {
         for other in [&agents, &seed, &leader] {
             assert!(!same_simulation(&base, other), "{other:?}");
         }
+    }
+
+    /// Mapping one simulation with several worlds gives, for each, the summary of its own
+    /// run ([`run_world`] mapping after the simulation), timings aside; the one simulation
+    /// is timed once for all.
+    #[test]
+    fn variants_of_one_simulation_map_as_their_own_runs() {
+        let text = include_str!("../tests/fixtures/worlds/tiny.ron");
+        let tiny = crate::world::parse_str(text, "tiny.ron")
+            .and_then(WorldSpec::check)
+            .expect("the tiny world is valid");
+        let mut other = tiny.clone();
+        other.mapping.cluster_cutoff = 20.0;
+        other.mapping.subsample = 100;
+        let worlds = [tiny, other];
+        let seed = 2;
+        let got = Mutex::new(Vec::new());
+        run_world_variants(&worlds, seed, &|i, s| {
+            got.lock().unwrap().push((i, s.expect("maps")));
+        })
+        .expect("simulates");
+        let mut got = got.into_inner().unwrap();
+        got.sort_by_key(|(i, _)| *i);
+        assert_eq!(got.len(), 2);
+        let without_timings = |s: &Summary| {
+            let mut v = serde_json::to_value(s).unwrap();
+            v.as_object_mut().unwrap().remove("timings");
+            v
+        };
+        for (i, shared) in &got {
+            let opts = RunOptions {
+                seed,
+                out: None,
+                trajectories: None,
+                progress: None,
+                alongside: Alongside::Off,
+            };
+            let (_, own) = run_world(&worlds[*i], &opts).expect("runs");
+            assert_eq!(
+                without_timings(shared),
+                without_timings(&own.summary),
+                "world {i}"
+            );
+        }
+        let simulation = |k: usize| got[k].1.timings["simulation"];
+        assert!(simulation(0) > 0.0);
+        assert_eq!(simulation(0), simulation(1));
     }
 }

@@ -491,6 +491,49 @@ fn map_sweep_picks_the_rank_and_models_of_a_worldless_log() {
         .assert()
         .success();
     assert_eq!(json(&log.join("maps/window_1.json"))["outlier_rank"], 2);
+    // --method takes the sweep too.
+    swarmmap()
+        .args([
+            "map",
+            "--windows",
+            "2",
+            "--overlap",
+            "30",
+            "--method",
+            "paper",
+        ])
+        .args(["--sweep", "0.0025"])
+        .arg(&log)
+        .assert()
+        .success();
+    assert_eq!(json(&log.join("maps/window_1.json"))["outlier_rank"], 16);
+    // A simulated run's world (its meta.json) fixes the sweep as --world does.
+    let run = tmp.path().join("run");
+    swarmmap()
+        .args(["map", "--sweep", "0.005"])
+        .arg(&run)
+        .assert()
+        .code(2)
+        .stderr(contains("meta.json) sweeps at 0.02 m/s"))
+        .stderr(contains(
+            "drop --sweep (the run recorded the sweep it was simulated at)",
+        ));
+    // A rank the run's world fixes is read back from its meta.json.
+    let fixed = tmp.path().join("fixed");
+    swarmmap()
+        .args([
+            "simulate",
+            TINY,
+            "--quiet",
+            "--set",
+            "mapping.outlier_rank=5",
+            "--out",
+        ])
+        .arg(&fixed)
+        .assert()
+        .success();
+    swarmmap().arg("map").arg(&fixed).assert().success();
+    assert_eq!(json(&fixed.join("maps/window_2.json"))["outlier_rank"], 5);
 }
 
 /// A static interval far beyond the encounters (a mistyped end) stretches the windows: the
@@ -844,6 +887,7 @@ fn eval_shares_one_simulation_among_mapping_variants() {
     let key = |cutoff: &str, seed: u64| (format!("mapping.cluster_cutoff={cutoff}"), seed);
     for seed in [1, 2] {
         let (a, b) = (&swept[&key("20", seed)], &swept[&key("50", seed)]);
+        assert!(a["summary"]["timings"]["simulation"].is_f64(), "{a}");
         assert_eq!(
             a["summary"]["timings"]["simulation"], b["summary"]["timings"]["simulation"],
             "seed {seed}: the two cut-offs share one simulation"

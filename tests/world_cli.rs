@@ -85,6 +85,20 @@ fn check_summarises_the_paper_mapping_without_rips_points() {
 }
 
 #[test]
+fn check_prints_an_outlier_rank_the_world_fixes() {
+    swarmmap()
+        .args([
+            "check",
+            "worlds/scenario3.ron",
+            "--set",
+            "mapping.outlier_rank=12",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("m = 400, outlier rank 12, k = 5;"));
+}
+
+#[test]
 fn check_rejects_an_invalid_world_with_status_2() {
     swarmmap()
         .args(["check", "tests/fixtures/worlds/negative_radius.ron"])

@@ -362,6 +362,23 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             given(w.leader.speed)
         )));
     }
+    // A model records its sweep, not the outlier rank it was fitted at: a map at this
+    // sweep uses the rank scaled with it unless its own world fixes one.
+    let scaled = swarmmap::mapping::subsample::rank_for_sweep(sweep);
+    if let Some((k, p)) = worlds.iter().zip(&paths).find_map(|(w, p)| {
+        w.mapping
+            .outlier_rank
+            .filter(|&k| k != scaled)
+            .map(|k| (k, p))
+    }) {
+        eprintln!(
+            "warning: {} maps with mapping.outlier_rank {k}, but the model records only its \
+             sweep ({} m/s), where maps use rank {scaled} unless their world sets the same \
+             rank; fit without the setting, or give it to the worlds mapped with this model",
+            p.display(),
+            given(sweep)
+        );
+    }
     // The fits each run feeds: the method's, the oracle's, or both.
     let oracle = args.oracle;
     let mut targets = Vec::new();
@@ -536,9 +553,27 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
     let mut csv = String::from(
         "method,h1_ratio,h1_span,h1_crossing,h1_stability,windows,b1_right,holeless,false_holes,within_cap\n",
     );
-    // The fits the false-hole cap constrained nothing in (warned of once, after them all:
-    // `--with-oracle` fits the method and the oracle on the same windows).
-    let mut unconstrained: Vec<(usize, String)> = Vec::new();
+    // The fits the false-hole cap constrains nothing in, warned of once before any fit
+    // (`--with-oracle` fits the method and the oracle on the same windows; a later fit's
+    // error must not hide the warning).
+    let unconstrained: Vec<String> = by_method
+        .iter()
+        .filter(|t| t.samples.iter().all(|s| s.truth[1] > 0) && args.max_false_holes < 1.0)
+        .map(|t| format!("{} ({} windows)", target_name(&t.target), t.samples.len()))
+        .collect();
+    if !unconstrained.is_empty() {
+        let fits = match unconstrained.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => unconstrained.concat(),
+        };
+        eprintln!(
+            "warning: no training window of the {fits} fit{} is hole-free, so \
+             --max-false-holes constrains nothing and the fit may show holes where there are \
+             none; add a world without obstacles to the training worlds (e.g. \
+             worlds/training/t_empty.ron)",
+            if unconstrained.len() == 1 { "" } else { "s" }
+        );
+    }
     for Training {
         target: method,
         samples,
@@ -574,9 +609,6 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             100.0 * f.b1_accuracy,
             100.0 * f.false_holes
         );
-        if samples.iter().all(|s| s.truth[1] > 0) && args.max_false_holes < 1.0 {
-            unconstrained.push((samples.len(), target_name(method)));
-        }
         if args.landscape.is_some() {
             let holeless = samples.iter().filter(|s| s.truth[1] == 0).count();
             for p in h1_landscape(samples, options) {
@@ -674,20 +706,6 @@ pub fn run(args: &CalibrateArgs) -> Result<(), Failure> {
             target_name(method),
             bank.0.len(),
             if bank.0.len() == 1 { "" } else { "s" }
-        );
-    }
-    if let Some(&(windows, _)) = unconstrained.first() {
-        let fits: Vec<&str> = unconstrained
-            .iter()
-            .map(|(_, name)| name.as_str())
-            .collect();
-        eprintln!(
-            "warning: none of the {windows} training windows is hole-free, so \
-             --max-false-holes constrained nothing and the {} fit{} may show holes where there \
-             are none; add a world without obstacles to the training worlds (e.g. \
-             worlds/training/t_empty.ron)",
-            fits.join(" and "),
-            if fits.len() == 1 { "" } else { "s" }
         );
     }
     if let Some(path) = &args.landscape {

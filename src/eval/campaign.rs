@@ -16,8 +16,9 @@ use crate::world::{World, WorldSpec, apply_override};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// One run of a campaign.
 #[derive(Debug, Clone, PartialEq)]
@@ -224,6 +225,8 @@ pub fn run_campaign(
     };
     let mut out = Vec::new();
     let mut groups: Vec<SimGroup> = Vec::new();
+    // The groups of each seed, so that finding a job's group scans only its seed's.
+    let mut by_seed: HashMap<u64, Vec<usize>> = HashMap::new();
     for job in jobs {
         let text = &texts[&job.world];
         let path = runs.join(format!("{}.json", job.key(text, models.as_deref())));
@@ -238,15 +241,20 @@ pub fn run_campaign(
         match job_world(job, text) {
             Err((label, e)) => out.push(store(record(job, label, Err(e)), &path)?),
             Ok(world) => {
-                let shared = groups
-                    .iter_mut()
-                    .find(|g| g.seed == job.seed && same_simulation(&g.members[0].2, &world));
+                let of_seed = by_seed.entry(job.seed).or_default();
+                let shared = of_seed
+                    .iter()
+                    .copied()
+                    .find(|&g| same_simulation(&groups[g].members[0].2, &world));
                 match shared {
-                    Some(g) => g.members.push((job, path, world)),
-                    None => groups.push(SimGroup {
-                        seed: job.seed,
-                        members: vec![(job, path, world)],
-                    }),
+                    Some(g) => groups[g].members.push((job, path, world)),
+                    None => {
+                        of_seed.push(groups.len());
+                        groups.push(SimGroup {
+                            seed: job.seed,
+                            members: vec![(job, path, world)],
+                        });
+                    }
                 }
             }
         }
@@ -255,44 +263,42 @@ pub fn run_campaign(
         .num_threads(threads.clamp(1, jobs.len().max(1)))
         .build()
         .map_err(std::io::Error::other)?;
-    let records: Vec<std::io::Result<RunRecord>> = pool.install(|| {
-        groups
-            .par_iter()
-            .flat_map_iter(|g| {
-                // Parameter sets that give one world (`eval` warns of them) are mapped once.
-                let mut worlds: Vec<World> = Vec::new();
-                let which: Vec<usize> = g
-                    .members
-                    .iter()
-                    .map(|(_, _, w)| {
-                        worlds.iter().position(|u| u == w).unwrap_or_else(|| {
-                            worlds.push(w.clone());
-                            worlds.len() - 1
-                        })
+    let stored = Mutex::new(Vec::new());
+    pool.install(|| {
+        groups.par_iter().for_each(|g| {
+            // Parameter sets that give one world (`eval` warns of them) are mapped once.
+            let mut worlds: Vec<&World> = Vec::new();
+            let which: Vec<usize> = g
+                .members
+                .iter()
+                .map(|(_, _, w)| {
+                    worlds.iter().position(|u| *u == w).unwrap_or_else(|| {
+                        worlds.push(w);
+                        worlds.len() - 1
                     })
-                    .collect();
-                let results: Vec<Result<Summary, String>> =
-                    match run_world_variants(&worlds, g.seed) {
-                        Ok(results) => results
-                            .into_iter()
-                            .map(|r| r.map_err(|e| e.to_string()))
-                            .collect(),
-                        Err(e) => vec![Err(e.to_string()); worlds.len()],
-                    };
-                g.members
-                    .iter()
-                    .zip(which)
-                    .map(|((job, path, world), u)| {
-                        store(
-                            record(job, Some(world.name.clone()), results[u].clone()),
-                            path,
-                        )
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect()
+                })
+                .collect();
+            // Each job is stored as soon as its world is mapped.
+            let finished = |u: usize, result: Result<Summary, String>| {
+                for ((job, path, world), _) in
+                    g.members.iter().zip(&which).filter(|(_, w)| **w == u)
+                {
+                    let rec = store(record(job, Some(world.name.clone()), result.clone()), path);
+                    stored.lock().unwrap_or_else(|e| e.into_inner()).push(rec);
+                }
+            };
+            let unique: Vec<World> = worlds.iter().map(|w| (*w).clone()).collect();
+            let simulated = run_world_variants(&unique, g.seed, &|u, result| {
+                finished(u, result.map_err(|e| e.to_string()));
+            });
+            if let Err(e) = simulated {
+                for u in 0..unique.len() {
+                    finished(u, Err(e.to_string()));
+                }
+            }
+        });
     });
-    for rec in records {
+    for rec in stored.into_inner().unwrap_or_else(|e| e.into_inner()) {
         out.push(rec?);
     }
     out.sort_by(|a, b| {

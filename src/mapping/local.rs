@@ -240,9 +240,9 @@ pub struct LocalMap {
     /// The thresholds the window was judged by: the model of `LocalParams::classifier`
     /// fitted nearest `events_per_point`.
     pub classifier: Classifier,
-    /// The outlier filter's neighbour rank k the representatives were picked with
-    /// (`LocalParams::subsample.k`, scaled with the sweep:
-    /// [`super::subsample::rank_for_sweep`]).
+    /// The outlier filter's configured neighbour rank k the representatives were picked
+    /// with (`LocalParams::subsample.k`: `mapping.outlier_rank`, else scaled with the
+    /// sweep, [`super::subsample::rank_for_sweep`]).
     pub outlier_rank: usize,
     /// Distance rows from each component's representatives, kept for fidelity and
     /// stitching: `(event index, row over the window's events)`.

@@ -122,8 +122,9 @@ struct WindowOut<'a> {
     events_per_point: f64,
     /// The classifier's thresholds the diagrams were judged with (see `classify.rs`).
     classifier: Classifier,
-    /// The outlier filter's neighbour rank k the representatives were picked with (it
-    /// scales with the leader's sweep: `subsample::rank_for_sweep`).
+    /// The outlier filter's configured neighbour rank k the representatives were picked
+    /// with (`mapping.outlier_rank`, else scaled with the leader's sweep:
+    /// `subsample::rank_for_sweep`).
     outlier_rank: usize,
     events: Vec<EventOut>,
     components: &'a [super::local::Component],

@@ -60,7 +60,7 @@ pub struct SubsampleParams {
     /// picks, so a window may keep slightly fewer than m).
     pub oversample: f64,
     /// Neighbour rank k of the density estimate (default: `8`; a world's mapping scales
-    /// it with the sweep: [`rank_for_sweep`]).
+    /// it with the sweep, [`rank_for_sweep`], unless its `mapping.outlier_rank` fixes it).
     pub k: usize,
     /// A candidate whose k-NN radius exceeds this multiple of the median is an outlier
     /// (default: `3.0`).
