@@ -638,7 +638,8 @@ pub fn same_simulation(a: &World, b: &World) -> bool {
 /// Simulates the first of `worlds` once (without writing it) and maps its log with each
 /// of them, in parallel on the current rayon pool: what [`run_world`] with
 /// [`Alongside::Off`] gives for each world, summary for summary, but with one simulation
-/// instead of one per world. Each summary is handed to `done` with its world's index as
+/// instead of one per world (and one raster of the free space, which the worlds share).
+/// Each summary is handed to `done` with its world's index as
 /// soon as it is ready (so that a campaign stores it at once); its `timings` hold the one
 /// simulation's time. The error is the simulation's, shared by every world (none is then
 /// handed to `done`).
@@ -661,6 +662,11 @@ pub fn run_world_variants(
     );
     let mut timings = Timings::default();
     let out = timings.time("simulation", || simulate(first, &SimOptions::new(seed)))?;
+    // The free space is the arena's, the obstacles' and the swarm's, which every world
+    // shares: rasterised once (an error is left for each world's `finish` to report).
+    let free = timings
+        .time("evaluation", || FreeSpace::for_world(first))
+        .ok();
     worlds.par_iter().enumerate().for_each(|(i, world)| {
         let cfg = MapConfig::for_world(world);
         let stitch = StitchParams {
@@ -669,7 +675,10 @@ pub fn run_world_variants(
         };
         let windows = cfg.windows();
         let mut timings = timings.clone();
-        let partial = Partial::new(windows.len());
+        let partial = Partial {
+            free: free.clone(),
+            ..Partial::new(windows.len())
+        };
         let mapped = finish(
             &out.log,
             Some(world),
