@@ -339,7 +339,6 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
         .success();
     let s = json(&run.join("summary.json"));
     assert_eq!(s["windows"].as_array().unwrap().len(), 2, "{s}");
-    let before = fs::read(log.join("summary.json")).unwrap();
     for (sets, says) in [
         (
             &["--set", "swarm.agents=3"][..],
@@ -366,15 +365,22 @@ fn map_takes_mapping_settings_with_or_without_a_world() {
             "map (--set mapping.rips_points=0): mapping.rips_points is 0",
         ),
     ] {
-        swarmmap()
-            .args(["map", "--windows", "2", "--overlap", "30"])
-            .args(sets)
-            .arg(&log)
-            .assert()
-            .code(2)
-            .stderr(contains(says));
-        assert_eq!(fs::read(log.join("summary.json")).unwrap(), before);
+        map_refused(&log, sets, says);
     }
+}
+
+/// `swarmmap map --windows 2 --overlap 30 EXTRA LOG` fails with status 2, says `says`, and
+/// leaves the log's `summary.json` as it was.
+fn map_refused(log: &Path, extra: &[&str], says: &str) {
+    let before = fs::read(log.join("summary.json")).unwrap();
+    swarmmap()
+        .args(["map", "--windows", "2", "--overlap", "30"])
+        .args(extra)
+        .arg(log)
+        .assert()
+        .code(2)
+        .stderr(contains(says));
+    assert_eq!(fs::read(log.join("summary.json")).unwrap(), before);
 }
 
 /// `swarmmap map --windows 2 --overlap 30 EXTRA LOG`, which must succeed: its stderr.
@@ -461,7 +467,6 @@ fn map_sweep_picks_the_rank_and_models_of_a_worldless_log() {
             assert_eq!(w["classifier"]["h1_ratio"] == 1e9, marked, "{extra:?}");
         }
     }
-    let before = fs::read(log.join("summary.json")).unwrap();
     for (extra, says) in [
         (
             &["--sweep", "0"][..],
@@ -475,14 +480,7 @@ fn map_sweep_picks_the_rank_and_models_of_a_worldless_log() {
             "sweeps at 0.02 m/s (its leader.speed)",
         ),
     ] {
-        swarmmap()
-            .args(["map", "--windows", "2", "--overlap", "30"])
-            .args(extra)
-            .arg(&log)
-            .assert()
-            .code(2)
-            .stderr(contains(says));
-        assert_eq!(fs::read(log.join("summary.json")).unwrap(), before);
+        map_refused(&log, extra, says);
     }
     // The world's own sweep is accepted, and maps as the world does.
     swarmmap()
