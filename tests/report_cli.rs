@@ -234,6 +234,14 @@ fn run_writes_the_report_and_trajectories_unless_told_not_to() {
         .stdout(contains("report: ").and(contains("with replay")));
     assert!(a.join("report/index.html").exists());
     assert!(a.join("trajectories.csv").exists());
+    // The diagrams' captions say the outlier rank the windows were mapped with (2 at the
+    // tiny world's 0.02 m/s).
+    let html = fs::read_to_string(a.join("report/index.html")).unwrap();
+    assert!(
+        html.contains("neighbour rank k = 2."),
+        "{}",
+        &html[..html.len().min(2000)]
+    );
     let meta: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(a.join("meta.json")).unwrap()).unwrap();
     // Default interval: max(1 s, 210 s / 600) = 1 s.

@@ -82,6 +82,10 @@ pub struct WindowIn {
     /// The classifier's thresholds (absent in maps written before the report existed).
     #[serde(default)]
     pub classifier: Option<Classifier>,
+    /// The outlier filter's neighbour rank the representatives were picked with (absent in
+    /// maps written before it was recorded).
+    #[serde(default)]
+    pub outlier_rank: Option<usize>,
     pub events: Vec<EventIn>,
     pub components: Vec<ComponentIn>,
 }

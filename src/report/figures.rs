@@ -592,11 +592,19 @@ pub fn diagram(w: &WindowIn) -> Result<Figure, ReportError> {
         ),
         None => "These maps predate recorded thresholds; rerun `swarmmap map` to draw them.".into(),
     };
+    let rank = w
+        .outlier_rank
+        .map(|k| {
+            format!(
+                " The representatives were picked with the outlier filter's neighbour rank k = {k}."
+            )
+        })
+        .unwrap_or_default();
     Ok(Figure {
         name,
         title: format!("W{}: persistence diagram", w.index),
         caption: format!(
-            "Vietoris–Rips persistence of each real component's encounter metric (seconds): H0 blue dots, H1 orange triangles, robust classes ringed, essential classes on the ∞ line. {thresholds}"
+            "Vietoris–Rips persistence of each real component's encounter metric (seconds): H0 blue dots, H1 orange triangles, robust classes ringed, essential classes on the ∞ line. {thresholds}{rank}"
         ),
         svg,
     })
