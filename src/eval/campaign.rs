@@ -141,16 +141,15 @@ pub struct RunRecord {
     pub build: Option<String>,
 }
 
-/// A job's world: its file's text with the job's overrides and seed, checked; on failure
-/// the error, and the world's name when it is known by then.
-fn job_world(job: &Job, text: &str) -> Result<World, (Option<String>, String)> {
+/// A job's world: its file's text with the job's overrides and seed, checked.
+fn job_world(job: &Job, text: &str) -> Result<World, String> {
     let name = job.world.display().to_string();
-    let mut spec = crate::world::parse_str(text, &name).map_err(|e| (None, e.to_string()))?;
+    let mut spec = crate::world::parse_str(text, &name).map_err(|e| e.to_string())?;
     for (p, v) in &job.overrides {
-        apply_override(&mut spec, p, v).map_err(|e| (None, e.to_string()))?;
+        apply_override(&mut spec, p, v).map_err(|e| e.to_string())?;
     }
-    apply_override(&mut spec, "seed", &job.seed.to_string()).map_err(|e| (None, e.to_string()))?;
-    WorldSpec::check(spec).map_err(|e| (None, e.to_string()))
+    apply_override(&mut spec, "seed", &job.seed.to_string()).map_err(|e| e.to_string())?;
+    WorldSpec::check(spec).map_err(|e| e.to_string())
 }
 
 /// The record of `job`, labelled by its world's name (`label`, else the file's stem).
@@ -239,7 +238,7 @@ pub fn run_campaign(
             continue;
         }
         match job_world(job, text) {
-            Err((label, e)) => out.push(store(record(job, label, Err(e)), &path)?),
+            Err(e) => out.push(store(record(job, None, Err(e)), &path)?),
             Ok(world) => {
                 let of_seed = by_seed.entry(job.seed).or_default();
                 let shared = of_seed
