@@ -580,10 +580,7 @@ pub fn run_world(
         sim_opts = sim_opts.with_progress(p);
     }
     let cfg = MapConfig::for_world(world);
-    let stitch = StitchParams {
-        cutoff: world.mapping.cluster_cutoff,
-        neighbours: world.mapping.neighbours,
-    };
+    let stitch = StitchParams::from_mapping(&world.mapping);
     let windows = cfg.windows();
     if let Some(dir) = &opts.out {
         // Before the simulation, which may take hours: an output it cannot write is said now.
@@ -669,10 +666,7 @@ pub fn run_world_variants(
         .ok();
     worlds.par_iter().enumerate().for_each(|(i, world)| {
         let cfg = MapConfig::for_world(world);
-        let stitch = StitchParams {
-            cutoff: world.mapping.cluster_cutoff,
-            neighbours: world.mapping.neighbours,
-        };
+        let stitch = StitchParams::from_mapping(&world.mapping);
         let windows = cfg.windows();
         let mut timings = timings.clone();
         let partial = Partial {

@@ -201,10 +201,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
     let (mut cfg, stitch) = match &world {
         Some(w) => (
             MapConfig::for_world(w),
-            StitchParams {
-                cutoff: w.mapping.cluster_cutoff,
-                neighbours: w.mapping.neighbours,
-            },
+            StitchParams::from_mapping(&w.mapping),
         ),
         None => {
             let m = defaults.clone();
@@ -221,10 +218,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
                     span,
                     local: LocalParams::from_mapping_at(&m, sweep),
                 },
-                StitchParams {
-                    cutoff: m.cluster_cutoff,
-                    neighbours: m.neighbours,
-                },
+                StitchParams::from_mapping(&m),
             )
         }
     };

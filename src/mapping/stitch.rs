@@ -103,6 +103,16 @@ pub struct StitchParams {
     pub neighbours: usize,
 }
 
+impl StitchParams {
+    /// The stitching parameters of a world's `mapping` section.
+    pub fn from_mapping(m: &crate::world::MappingParams) -> Self {
+        Self {
+            cutoff: m.cluster_cutoff,
+            neighbours: m.neighbours,
+        }
+    }
+}
+
 /// One inter-domain point cloud and its clustering.
 #[derive(Debug, Clone, Serialize)]
 pub struct Connection {
