@@ -454,7 +454,12 @@ fn finish(
 /// extra files are gone: a `summary.json` present means a complete set of maps that it
 /// describes, and an interrupted or failed write leaves none (`swarmmap report` then asks
 /// for the maps to be made again) rather than the old summary beside new maps.
-pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), PipelineError> {
+///
+/// The maps' texts are made in parallel (a connection's dendrogram and display embedding
+/// cost more than a window's thousands of events) and written in order. The time this
+/// takes, up to the summary's own text, is added to the summary's `writing` stage.
+pub fn write_maps(dir: &Path, log: &EncounterLog, m: &mut Mapped) -> Result<(), PipelineError> {
+    let started = Instant::now();
     let summary = dir.join("summary.json");
     if let Err(source) = std::fs::remove_file(&summary)
         && source.kind() != std::io::ErrorKind::NotFound
@@ -464,33 +469,40 @@ pub fn write_maps(dir: &Path, log: &EncounterLog, m: &Mapped) -> Result<(), Pipe
             source,
         });
     }
-    let written = std::cell::RefCell::new(std::collections::BTreeSet::new());
-    let write = |name: String, text: String| {
-        let path = dir.join(&name);
-        if let Some(file) = name.strip_prefix("maps/") {
-            written.borrow_mut().insert(file.to_string());
-        }
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
         write_atomic(&path, text.as_bytes()).map_err(|source| PipelineError::Write { path, source })
     };
-    for (map, s) in m.maps.iter().zip(&m.summary.windows) {
-        write(
-            format!("maps/window_{}.json", map.index),
-            window_json(map, log, s.truth),
-        )?;
+    let windows = m.maps.len().min(m.summary.windows.len());
+    let files: Vec<(String, String)> = (0..windows + m.connections.len())
+        .into_par_iter()
+        .map(|k| match k.checked_sub(windows) {
+            None => {
+                let map = &m.maps[k];
+                let text = window_json(map, log, m.summary.windows[k].truth);
+                (format!("window_{}.json", map.index), text)
+            }
+            Some(c) => {
+                let c = &m.connections[c];
+                let text = connection_json(c, log, m.stitch.cutoff);
+                (format!("connection_{}.json", c.between[0]), text)
+            }
+        })
+        .collect();
+    let mut written = std::collections::BTreeSet::new();
+    for (file, text) in files.into_iter().chain([
+        ("connections.json".to_string(), to_json(&m.connections)),
+        ("global.json".to_string(), to_json(&m.global)),
+    ]) {
+        write(&format!("maps/{file}"), &text)?;
+        written.insert(file);
     }
-    for c in &m.connections {
-        write(
-            format!("maps/connection_{}.json", c.between[0]),
-            connection_json(c, log, m.stitch.cutoff),
-        )?;
-    }
-    write("maps/connections.json".into(), to_json(&m.connections))?;
-    write("maps/global.json".into(), to_json(&m.global))?;
     // A log mapped before with more windows left files these maps do not replace.
     let maps = dir.join("maps");
-    remove_stale(&maps, &written.borrow(), is_numbered_map)
+    remove_stale(&maps, &written, is_numbered_map)
         .map_err(|source| PipelineError::Write { path: maps, source })?;
-    write("summary.json".into(), to_json(&m.summary))
+    *m.summary.timings.entry("writing".to_string()).or_default() += started.elapsed().as_secs_f64();
+    write("summary.json", &to_json(&m.summary))
 }
 
 /// Pretty JSON with a trailing newline.
@@ -618,7 +630,7 @@ pub fn run_world(
     )?;
     mapped.summary.alongside = alongside.0;
     if let Some(dir) = &opts.out {
-        write_maps(dir, &out.log, &mapped)?;
+        write_maps(dir, &out.log, &mut mapped)?;
     }
     Ok((out, mapped))
 }

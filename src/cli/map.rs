@@ -375,7 +375,7 @@ pub fn run(args: &MapArgs) -> Result<(), Failure> {
         path: args.run_dir.join("report"),
         source,
     })?;
-    write_maps(&args.run_dir, &log, &mapped)?;
+    write_maps(&args.run_dir, &log, &mut mapped)?;
     print!("{}", mapped.summary.table());
     if let Some(w) = swarmmap::pipeline::density_warning(&mapped.maps, &cfg.local.classifier) {
         eprintln!("warning: {w}");
