@@ -227,13 +227,14 @@ fn sigterm_and_sighup_are_handled_like_ctrl_c() {
     for signal in ["TERM", "HUP"] {
         let out = tmp.path().join(signal);
         // A run that takes seconds: the signal lands after start-up, mid-simulation.
-        let child = Command::new(env!("CARGO_BIN_EXE_swarmmap"))
+        let mut command = Command::new(env!("CARGO_BIN_EXE_swarmmap"));
+        command
             .args(["simulate", "worlds/scenario2.ron", "--quiet", "--out"])
             .arg(&out)
             .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+            .stderr(Stdio::piped());
+        hang_up_as_by_default(&mut command);
+        let child = command.spawn().unwrap();
         std::thread::sleep(std::time::Duration::from_millis(800));
         kill(signal, child.id());
         let output = child.wait_with_output().unwrap();
@@ -282,6 +283,23 @@ fn a_run_started_under_nohup_ignores_the_hang_up() {
     assert_eq!(child.wait().unwrap().code(), Some(130));
 }
 
+/// Starts `command` with SIGHUP's default disposition. A run started with SIGHUP ignored
+/// keeps it ignored ([`a_run_started_under_nohup_ignores_the_hang_up`]), and a child
+/// inherits an ignored disposition: without this, the tests that expect a hang-up to stop
+/// the run failed whenever the suite itself ran under `nohup` (forty-fourth session: `nohup
+/// ./.ci/run`).
+fn hang_up_as_by_default(command: &mut Command) {
+    // SAFETY: `signal` is async-signal-safe, so it may run between fork and exec.
+    unsafe {
+        command.pre_exec(|| {
+            if libc::signal(libc::SIGHUP, libc::SIG_DFL) == libc::SIG_ERR {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+}
+
 /// Sends SIG`signal` to process `pid`.
 fn kill(signal: &str, pid: u32) {
     let _ = Command::new("kill")
@@ -289,7 +307,42 @@ fn kill(signal: &str, pid: u32) {
         .status();
 }
 
+/// A pseudo-terminal's master and slave, both opened close-on-exec, so that no run another
+/// test spawns meanwhile inherits them: a copy of the master in another process would keep
+/// the terminal from hanging up when this test closes its own (until the forty-fourth
+/// session the master was made close-on-exec only after `openpty` had returned).
+#[cfg(target_os = "linux")]
+fn open_pty() -> Option<(std::os::fd::OwnedFd, std::os::fd::OwnedFd)> {
+    use std::os::fd::{AsRawFd, OwnedFd};
+    // SAFETY: each descriptor is owned as soon as it is opened; `name` is a buffer of the
+    // length passed, which `ptsname_r` NUL-terminates on success.
+    unsafe {
+        let master = libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY | libc::O_CLOEXEC);
+        if master < 0 {
+            return None;
+        }
+        let master = OwnedFd::from_raw_fd(master);
+        if libc::grantpt(master.as_raw_fd()) != 0 || libc::unlockpt(master.as_raw_fd()) != 0 {
+            return None;
+        }
+        let mut name = [0 as libc::c_char; 256];
+        if libc::ptsname_r(master.as_raw_fd(), name.as_mut_ptr(), name.len()) != 0 {
+            return None;
+        }
+        // Not our controlling terminal (`O_NOCTTY`): the run makes it its own.
+        let slave = libc::open(
+            name.as_ptr(),
+            libc::O_RDWR | libc::O_NOCTTY | libc::O_CLOEXEC,
+        );
+        if slave < 0 {
+            return None;
+        }
+        Some((master, OwnedFd::from_raw_fd(slave)))
+    }
+}
+
 #[test]
+#[cfg(target_os = "linux")]
 fn a_hang_up_of_the_terminal_stops_the_run_cleanly() {
     // Found by the fortieth session's review: when the terminal hangs up, stderr is gone
     // (writes fail with EIO) and an `eprintln!` in the handler panicked, so the handler's
@@ -298,33 +351,9 @@ fn a_hang_up_of_the_terminal_stops_the_run_cleanly() {
     // master hangs it up (SIGHUP, then EIO on every write).
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("run");
-    let (mut master, mut slave) = (-1, -1);
-    // SAFETY: `openpty` fills the two descriptors; null name, termios and window size ask
-    // for the defaults.
-    let opened = unsafe {
-        libc::openpty(
-            &mut master,
-            &mut slave,
-            std::ptr::null_mut(),
-            std::ptr::null(),
-            std::ptr::null(),
-        )
-    };
-    if opened != 0 {
+    let Some((master, slave)) = open_pty() else {
         eprintln!("no pseudo-terminal on this machine: skipped");
         return;
-    }
-    // SAFETY: `master` is open. Close-on-exec: a copy of the master inherited by the run
-    // would keep the terminal from hanging up.
-    unsafe {
-        libc::fcntl(master, libc::F_SETFD, libc::FD_CLOEXEC);
-    }
-    // SAFETY: `slave` and `master` are open descriptors this test alone owns.
-    let (slave, master) = unsafe {
-        (
-            std::os::fd::OwnedFd::from_raw_fd(slave),
-            std::os::fd::OwnedFd::from_raw_fd(master),
-        )
     };
     let mut command = Command::new(env!("CARGO_BIN_EXE_swarmmap"));
     command
@@ -333,6 +362,7 @@ fn a_hang_up_of_the_terminal_stops_the_run_cleanly() {
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::from(slave));
+    hang_up_as_by_default(&mut command);
     // SAFETY: only async-signal-safe calls between fork and exec: a new session, then the
     // pseudo-terminal (now the child's stderr) as its controlling terminal.
     unsafe {
