@@ -7,7 +7,6 @@
 #![cfg(unix)]
 
 use std::collections::BTreeMap;
-use std::os::fd::FromRawFd;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -313,7 +312,7 @@ fn kill(signal: &str, pid: u32) {
 /// session the master was made close-on-exec only after `openpty` had returned).
 #[cfg(target_os = "linux")]
 fn open_pty() -> Option<(std::os::fd::OwnedFd, std::os::fd::OwnedFd)> {
-    use std::os::fd::{AsRawFd, OwnedFd};
+    use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
     // SAFETY: each descriptor is owned as soon as it is opened; `name` is a buffer of the
     // length passed, which `ptsname_r` NUL-terminates on success.
     unsafe {
