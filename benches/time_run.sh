@@ -5,7 +5,7 @@
 # Usage: benches/time_run.sh [RUNS] [--report]
 #   RUNS       runs of scenario 2 (default 5), one after another
 #   --report   also write the report (the README's first command does); default --no-report
-# Environment: BIN (default: this checkout's release build, built if missing).
+# Environment: BIN (default: this checkout's release build, brought up to date first).
 #
 # The host this project is measured on is shared, and one binary's time moves by up to
 # 80 % from hour to hour (docs/speed.md, "The run of scenario 2, session by session"). So
