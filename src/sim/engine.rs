@@ -1,17 +1,18 @@
-//! The simulation loop: agent behaviour, landmark upkeep, the leader, and the bookkeeping
-//! that turns physics events into the encounter log.
+//! The simulation loop: agent behaviour, landmark upkeep, the leader, the contacts that
+//! turn agents, and the log (its encounters come from the detector, `sensing.rs`, which
+//! the loop hands each configuration).
 
 use super::landmarks;
 use super::params::{
     AgentState, SimError, SimOptions, SimOutput, SimStats, Trajectories, TrajectorySample,
 };
-use super::physics::{RawEvent, SIDES, Scene};
+use super::physics::{RawEvent, SIDES, Scene, SensorWorld};
 use super::placement;
+use super::sensing::{Detector, Sensing};
 use crate::log::{AgentId, Encounter, EncounterLog, StaticInterval, StaticReason};
 use crate::world::{ObstacleDistances, World};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -487,7 +488,6 @@ struct Run<'w> {
     /// Landmarks in the order they were chosen.
     landmarks: Vec<usize>,
     landmarks_started: bool,
-    open: HashMap<(u32, u32), (f64, [f64; 4])>,
     /// Pairs Rapier reports within the contact prediction distance, sorted, each with
     /// whether its bodies touch (gap below [`TOUCH_GAP`]). A few dozen at most in a dense
     /// swarm, walked every step: a sorted vector, not a tree.
@@ -667,26 +667,12 @@ impl Run<'_> {
         self.landmarks_started = true;
     }
 
-    /// Applies the events seen at time `t` (configuration `pos`).
-    fn handle_events(&mut self, events: &[RawEvent], pos: &[P], t: f64) {
+    /// Applies the contact events of a configuration (sensor events go to the detector,
+    /// `sensing.rs`).
+    fn handle_events(&mut self, events: &[RawEvent]) {
         for &ev in events {
             match ev {
-                RawEvent::Sensor { a, b, started } => {
-                    if started {
-                        let (pa, pb) = (pos[a as usize], pos[b as usize]);
-                        self.open
-                            .entry((a, b))
-                            .or_insert((t, [pa.0, pa.1, pb.0, pb.1]));
-                    } else if let Some((start, truth)) = self.open.remove(&(a, b)) {
-                        self.log.encounters.push(Encounter {
-                            start,
-                            end: t,
-                            a,
-                            b,
-                            truth: Some(truth),
-                        });
-                    }
-                }
+                RawEvent::Sensor { .. } => {}
                 RawEvent::AgentContact { a, b, started } => {
                     self.set_near((a, Other::Agent(b)), started);
                 }
@@ -822,36 +808,56 @@ fn static_order(x: &StaticInterval, y: &StaticInterval) -> std::cmp::Ordering {
 }
 
 impl Run<'_> {
-    /// The log's prefix up to the cut `c` ([`SimOptions::with_prefixes`]); static
-    /// intervals still running end at `cut_off`.
-    fn prefix(&self, c: f64, cut_off: f64) -> EncounterLog {
-        let encounters: Vec<Encounter> = self
-            .log
-            .encounters
-            .iter()
-            // The final log's windows take its rounded starts (`as_written`): so does the cut.
-            .filter(|e| crate::log::written(e.start, &mut String::new()) <= c)
-            .cloned()
-            .collect();
-        let mut static_intervals = self.log.static_intervals.clone();
+    /// A cut's prefix of the log ([`SimOptions::with_prefixes`]) as it stood at time `t` (a
+    /// step time not after the current one), given the encounters that started at or
+    /// before the cut; static intervals running at `t` end one step later.
+    ///
+    /// The detector settles a cut behind the loop, so the state at `t` is rebuilt from the
+    /// present one: the static intervals closed by `t` are those that end at or before it
+    /// (every interval is closed at the time of the step that closes it), those running at
+    /// `t` are the ones that began by `t` and are still running or ended later, and the
+    /// leader's track is cut at `t`.
+    fn prefix(&self, t: f64, dt: f64, encounters: &[Encounter]) -> EncounterLog {
+        let cut_off = t + dt;
+        let mut static_intervals: Vec<StaticInterval> = Vec::new();
+        for s in &self.log.static_intervals {
+            if s.end <= t {
+                static_intervals.push(s.clone());
+            } else if s.start <= t {
+                static_intervals.push(StaticInterval {
+                    end: cut_off,
+                    ..s.clone()
+                });
+            }
+        }
         for (i, a) in self.agents.iter().enumerate() {
             let reason = match a.state {
                 AgentState::Pause => StaticReason::Pause,
                 AgentState::Landmark => StaticReason::Landmark,
                 _ => continue,
             };
-            static_intervals.push(StaticInterval {
-                agent: i as AgentId,
-                start: a.static_since,
-                end: cut_off,
-                reason,
-            });
+            if a.static_since <= t {
+                static_intervals.push(StaticInterval {
+                    agent: i as AgentId,
+                    start: a.static_since,
+                    end: cut_off,
+                    reason,
+                });
+            }
         }
+        let encounters = encounters.to_vec();
+        let leader = self
+            .log
+            .leader
+            .iter()
+            .take_while(|&&(time, _)| time <= t)
+            .copied()
+            .collect();
         // As the files will hold it, then in the files' order.
         let mut log = EncounterLog {
             encounters,
             static_intervals,
-            leader: self.log.leader.clone(),
+            leader,
         }
         .as_written();
         log.encounters.sort_by(encounter_order);
@@ -879,6 +885,11 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let start = placement::place(world, &mut rng)?;
     let mut scene = Scene::new(world, &start, dt);
+    let cuts = opts.prefixes.map_or(&[][..], |(cuts, _)| cuts);
+    let mut sensing = Sensing::start(
+        Detector::new(SensorWorld::new(world, &start, dt), dt, n_steps, cuts),
+        n_agents,
+    );
     let mut run = Run {
         world,
         terrain: Terrain::new(world),
@@ -887,7 +898,6 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
             .collect(),
         landmarks: Vec::new(),
         landmarks_started: false,
-        open: HashMap::new(),
         near: Vec::new(),
         log: EncounterLog::default(),
         stats: SimStats::default(),
@@ -905,7 +915,6 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     let mut events = Vec::new();
     let mut physics_time = 0.0;
     let mut landmark_time = 0.0;
-    let mut next_cut = 0;
     for k in 0..=n_steps {
         let t = k as f64 * dt;
         if let Some(i) = scene.read_positions(&mut pos) {
@@ -914,9 +923,10 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
                 time: t,
             });
         }
+        let last = k == n_steps;
+        sensing.push(k, &pos, last);
         let domain = world.domain(t);
         let leader_x = world.leader_x(t);
-        let last = k == n_steps;
         if !last {
             run.detect_touches(&pos);
             for (i, &p) in pos.iter().enumerate() {
@@ -966,22 +976,13 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         events.clear();
         scene.step(if last { 0.0 } else { dt }, &mut events);
         physics_time += t0.elapsed().as_secs_f64();
-        run.handle_events(&events, &pos, t);
+        run.handle_events(&events);
         if last {
             break;
         }
-        if let Some((cuts, hand_out)) = opts.prefixes {
-            while let Some(&c) = cuts.get(next_cut) {
-                if t < c
-                    || run
-                        .open
-                        .values()
-                        .any(|&(start, _)| crate::log::written(start, &mut String::new()) <= c)
-                {
-                    break;
-                }
-                hand_out(next_cut, &|| run.prefix(c, t + dt));
-                next_cut += 1;
+        if let Some((_, hand_out)) = opts.prefixes {
+            for s in sensing.settled() {
+                hand_out(s.cut, &|| run.prefix(s.step as f64 * dt, dt, &s.encounters));
             }
         }
         if let Some(report) = opts.progress
@@ -991,8 +992,16 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
         }
     }
 
+    // Cuts settled before the end but heard of only now are handed out as they stood.
+    let (detected, late) = sensing.finish();
+    if let Some((_, hand_out)) = opts.prefixes {
+        for s in late {
+            hand_out(s.cut, &|| run.prefix(s.step as f64 * dt, dt, &s.encounters));
+        }
+    }
+    run.log.encounters = detected.encounters;
     // Close what is still open at the final time.
-    let mut still_open: Vec<_> = run.open.drain().collect();
+    let mut still_open = detected.open;
     still_open.sort_unstable_by_key(|&((a, b), _)| (a, b));
     for ((a, b), (start, truth)) in still_open {
         run.log.encounters.push(Encounter {
@@ -1023,6 +1032,7 @@ pub fn simulate(world: &World, opts: &SimOptions) -> Result<SimOutput, SimError>
     stats.encounters = log.encounters.len();
     stats.static_intervals = log.static_intervals.len();
     stats.physics_time_s = physics_time;
+    stats.sensing_time_s = detected.busy_s;
     stats.landmark_time_s = landmark_time;
     stats.wall_time_s = wall.elapsed().as_secs_f64();
     Ok(SimOutput {

@@ -23,13 +23,17 @@
 //! (`landmarks.rs`). The leader then sweeps from `start_x` to `end_x` at `leader.speed`; the
 //! run ends when it arrives.
 //!
-//! **Encounters** come from Rapier's sensor events (`physics.rs`); an encounter starts at
-//! the first step time at which the centres are within r_d and ends at the first step time
-//! at which they are not (or at the final time). Times are multiples of `simulation.dt`.
+//! **Encounters** come from Rapier's sensor events in a sensing world of their own
+//! (`physics.rs`), run on a second thread that follows the physics step by step
+//! (`sensing.rs`); an encounter starts at the first step time at which the centres are
+//! within r_d and ends at the first step time at which they are not (or at the final time).
+//! Times are multiples of `simulation.dt`.
 //!
-//! **Cost.** Each step is one Rapier step, O(n log n) for n agents (BVH broad phase, a
-//! handful of contacts per agent), plus O(n) bookkeeping; landmark selection costs
-//! O(n + E) on the communication graph and runs only when the landmark count falls short.
+//! **Cost.** Each step is one Rapier step of the physics world, O(n log n) for n agents
+//! (BVH broad phase, a handful of contacts per agent), plus O(n) bookkeeping, and beside it
+//! one collision-detection pass of the sensing world, also O(n log n); landmark selection
+//! costs O(n + E) on the communication graph and runs only when the landmark count falls
+//! short.
 //!
 //! **Randomness.** One ChaCha8 stream per agent (stream `i + 1` of the seed) drives its
 //! walk; stream 0 drives placement and landmark selection. Events are sorted before they
@@ -41,6 +45,7 @@ mod output;
 mod params;
 mod physics;
 mod placement;
+mod sensing;
 pub use placement::PLACEMENT_GAP;
 
 pub use engine::{LEADER_INTERVAL, RETURN_ESCAPE, RETURN_NOISE, simulate};

@@ -216,6 +216,7 @@ pub fn meta_json(world: &World, out: &SimOutput) -> Vec<u8> {
             "wall_time_s": st.wall_time_s,
             "physics_s": st.physics_time_s,
             "landmarks_s": st.landmark_time_s,
+            "sensing_s": st.sensing_time_s,
         },
     });
     let mut bytes = serde_json::to_vec_pretty(&meta).unwrap_or_default();

@@ -49,15 +49,17 @@ impl<'a> SimOptions<'a> {
     }
 
     /// Hands out the final log's prefixes while the run goes on: for each cut time `c` of
-    /// `cuts` (ascending), as soon as the simulation has passed `c` and every encounter
-    /// that started at or before `c` has ended, `f(k, build)` is called (`k` indexes `cuts`);
-    /// `build()` returns a log that holds
+    /// `cuts` (ascending), the cut is settled at the first step time `t ≥ c` at which every
+    /// encounter that started at or before `c` has ended; once the encounter detector
+    /// (which runs a little behind the physics, on its own thread) has settled it,
+    /// `f(k, build)` is called (`k` indexes `cuts`, in order); `build()` returns a log that
+    /// holds
     /// - every encounter that started at or before `c`, exactly as the final log will have
     ///   it and in its order (so an index into it is an index into the final log);
-    /// - every static interval that has started, as in the final log, except that one still
-    ///   running is cut off one time step after the current time `t` (its true end lies at
-    ///   or after that step): later than every encounter end in the prefix, as its true end is;
-    /// - the leader's positions so far.
+    /// - every static interval that had started by `t`, as in the final log, except that
+    ///   one running at `t` is cut off one time step after `t` (its true end lies at or
+    ///   after that step): later than every encounter end in the prefix, as its true end is;
+    /// - the leader's positions up to `t`.
     ///
     /// A cut that only the end of the run settles is not handed out: the final log serves.
     /// Anything that reads only the encounters that meet `[.., c]`, and of the static
@@ -155,6 +157,9 @@ pub struct SimStats {
     pub physics_time_s: f64,
     /// Wall time of landmark selection, seconds (not deterministic).
     pub landmark_time_s: f64,
+    /// Wall time of encounter detection (the sensing world, on its own thread), seconds
+    /// (not deterministic).
+    pub sensing_time_s: f64,
 }
 
 /// The result of [`simulate`](super::simulate).

@@ -1,17 +1,23 @@
-//! The Rapier 2D scene: fixed colliders for the arena's sides and the obstacles, one rigid
-//! body per agent with a solid ball and a sensor ball, and an event handler that turns
-//! Rapier's collision events into encounters and contacts.
+//! The Rapier 2D worlds of a run. The physics world holds fixed colliders for the arena's
+//! sides and the obstacles and one rigid body with a solid ball per agent; an event handler
+//! turns its collision events into contacts. The sensing world ([`SensorWorld`]) holds one
+//! sensor ball per agent and only runs collision detection; its intersection events become
+//! encounters (`sensing.rs`, on a thread of its own).
 //!
-//! Encounters come from sensor intersection: each agent carries a sensor ball of radius
-//! r_d / 2, so two sensors intersect exactly when the centres are within r_d. Sensors only
-//! see sensors (collision group 2) and solids only see solids and obstacles (groups 1
-//! and 3), so a sensor never reports an obstacle or another agent's body.
+//! Encounters come from sensor intersection: each agent's sensor ball has radius r_d / 2, so
+//! two sensors intersect exactly when the centres are within r_d. Solids only see solids and
+//! obstacles (collision groups 1 and 3) and sensors only sensors (group 2, in their own
+//! world), so a sensor never reports an obstacle or another agent's body. Until the
+//! forty-sixth session the sensor balls rode on the agents' bodies in the physics world;
+//! taking them out changed no trajectory, bit for bit (they never touched the solver, and
+//! the solid pairs' order does not depend on them), and made its steps about a third faster.
 //!
 //! Timing: Rapier's narrow phase runs at the start of `PhysicsPipeline::step`, on the
 //! positions the bodies have before the step integrates them. Every event handled during
 //! the step that advances `t_k → t_{k+1}` therefore describes the configuration at `t_k`
 //! (the centres crossed r_d during the previous step), and is stamped `t_k`. A final step
-//! with `dt = 0` reports the configuration at the last time.
+//! with `dt = 0` reports the configuration at the last time. The sensing world is given the
+//! configuration at `t_k` (the bodies' f32 translations, exactly) and reports on it.
 //!
 //! Static agents (paused or landmarks) stay dynamic bodies with their translations locked:
 //! a locked body has infinite effective mass, so moving agents bounce off it and never push
@@ -52,6 +58,12 @@ const SPARSE_SKIN_STEPS: f64 = 25.6;
 /// Largest expected number of other colliders overlapping a leaf's fat AABB for which the
 /// sparse skin pays; measured crossover between 6.7 and 13 agents/m² at the defaults.
 const SPARSE_MAX_NEIGHBOURS: f64 = 0.3;
+/// [`SPARSE_MAX_NEIGHBOURS`] for the sensing world, whose balls only ever need an
+/// intersection test. Sensing time, skins 1 / 2 / 4 / 7.7 cm: scenario 2 (200 agents,
+/// r_d = 10 cm, 0.43 expected neighbours at 7.7 cm) 5.4 / 5.5 / 4.2 / 4.0 s; `k1.ron` (1 000
+/// agents, r_d = 1 cm, 0.90) 0.32 / 0.31 / 0.34 / 0.48 s; `k10.ron` (10 000, 9.0) 0.45 /
+/// 0.61 / 0.98 / 1.92 s (forty-sixth session; docs/speed.md).
+const SENSING_MAX_NEIGHBOURS: f64 = 0.6;
 /// Rapier's contacts are speculative: a pair gets a contact constraint once its gap is
 /// below the prediction distance, and the solver then stops the bodies exactly at contact.
 /// The distance must exceed what two agents close in one step (2 v dt), or they overlap
@@ -167,6 +179,134 @@ impl EventHandler for Collector {
     }
 
     fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
+}
+
+/// A broad-phase skin for `world` at step `dt`, metres: [`SPARSE_SKIN_STEPS`] steps of
+/// travel when a fat AABB of that skin round a ball of `radius` is expected to overlap at
+/// most `max_neighbours` others (`per_agent` colliders per agent; agents are held in D(t),
+/// so the density is agents / (l × height)), else [`DENSE_SKIN`].
+fn skin_for(world: &World, dt: f64, per_agent: f64, radius: f64, max_neighbours: f64) -> f64 {
+    let sparse = SPARSE_SKIN_STEPS * world.swarm.speed * dt;
+    let area = world.leader.window.min(world.arena.width) * world.arena.height;
+    let density = world.swarm.agents as f64 / area;
+    let side = 2.0 * (sparse + radius);
+    let neighbours = per_agent * density * side * side;
+    if sparse > DENSE_SKIN && neighbours <= max_neighbours {
+        sparse
+    } else {
+        DENSE_SKIN
+    }
+}
+
+/// The sensing world: a second Rapier world that holds one sensor ball of radius r_d / 2
+/// per agent (collider `i` is agent `i`'s) and only runs collision detection. Its balls
+/// have no body (Rapier counts them as fixed, hence `FIXED_FIXED`) and are moved to the
+/// agents' positions before each detection.
+///
+/// Kept apart from [`Scene`] so that it can run on its own thread (`sensing.rs`): sensors
+/// never act on the motion, and the physics world without them steps about a third faster
+/// with bit-identical trajectories (the solid contacts, the solver's order and every
+/// tolerance are unchanged; docs/speed.md, "Forty-sixth session").
+pub(crate) struct SensorWorld {
+    params: IntegrationParameters,
+    pipeline: PhysicsPipeline,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    collector: Collector,
+    /// Where each ball is now; only the balls that moved are set again.
+    at: Vec<Vector>,
+    /// Each ball's handle, in agent order.
+    balls: Vec<ColliderHandle>,
+}
+
+impl SensorWorld {
+    /// One sensor ball per agent of `world`, at `positions`.
+    pub(crate) fn new(world: &World, positions: &[(f64, f64)], dt: f64) -> Self {
+        let radius = world.swarm.detection_radius / 2.0;
+        let skin = skin_for(world, dt, 1.0, radius, SENSING_MAX_NEIGHBOURS) as f32;
+        let params = IntegrationParameters {
+            dt: 0.0,
+            length_unit: skin / SKIN_FACTOR,
+            normalized_prediction_distance: 0.0,
+            ..IntegrationParameters::default()
+        };
+        let groups = InteractionGroups::new(GROUP_SENSOR, GROUP_SENSOR, InteractionTestMode::And);
+        let radius = radius as f32;
+        let mut colliders = ColliderSet::new();
+        let at: Vec<Vector> = positions.iter().map(|p| v(p.0, p.1)).collect();
+        let balls = at
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                colliders.insert(
+                    ColliderBuilder::ball(radius)
+                        .sensor(true)
+                        .translation(p)
+                        .collision_groups(groups)
+                        .active_collision_types(ActiveCollisionTypes::FIXED_FIXED)
+                        .active_events(ActiveEvents::COLLISION_EVENTS)
+                        .user_data(KIND_SENSOR | i as u128),
+                )
+            })
+            .collect();
+        Self {
+            params,
+            pipeline: PhysicsPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: BroadPhaseBvh::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies: RigidBodySet::new(),
+            colliders,
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::new(),
+            ccd: CCDSolver::new(),
+            collector: Collector::default(),
+            at,
+            balls,
+        }
+    }
+
+    /// Moves the balls to `positions` (one per agent, as [`Scene::read_positions`] gives
+    /// them) and appends the sensor events of that configuration to `out`, sorted.
+    pub(crate) fn detect(&mut self, positions: &[(f64, f64)], out: &mut Vec<RawEvent>) {
+        for ((p, at), &h) in positions.iter().zip(&mut self.at).zip(&self.balls) {
+            // Exact: the positions are the physics world's f32 translations widened.
+            let p = v(p.0, p.1);
+            if *at != p {
+                *at = p;
+                if let Some(ball) = self.colliders.get_mut(h) {
+                    ball.set_translation(p);
+                }
+            }
+        }
+        self.pipeline.step(
+            Vector::ZERO,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &self.collector,
+        );
+        if let Ok(mut events) = self.collector.events.lock() {
+            events.sort_unstable();
+            out.append(&mut events);
+        }
+    }
 }
 
 /// The Rapier state of a run.
@@ -298,10 +438,7 @@ impl Scene {
             GROUP_SOLID | GROUP_OBSTACLE,
             InteractionTestMode::And,
         );
-        let sensor_groups =
-            InteractionGroups::new(GROUP_SENSOR, GROUP_SENSOR, InteractionTestMode::And);
         let body_radius = world.swarm.body_radius as f32;
-        let sensor_radius = (world.swarm.detection_radius / 2.0) as f32;
         let mut agents = Vec::with_capacity(positions.len());
         for (i, p) in positions.iter().enumerate() {
             let handle = bodies.insert(
@@ -320,16 +457,6 @@ impl Scene {
                     .collision_groups(solid_groups)
                     .active_events(ActiveEvents::COLLISION_EVENTS)
                     .user_data(KIND_SOLID | i as u128),
-                handle,
-                &mut bodies,
-            );
-            colliders.insert_with_parent(
-                ColliderBuilder::ball(sensor_radius)
-                    .sensor(true)
-                    .density(0.0)
-                    .collision_groups(sensor_groups)
-                    .active_events(ActiveEvents::COLLISION_EVENTS)
-                    .user_data(KIND_SENSOR | i as u128),
                 handle,
                 &mut bodies,
             );
@@ -353,24 +480,16 @@ impl Scene {
     }
 
     /// Broad-phase skin for `world` at step `dt`, metres: [`SPARSE_SKIN_STEPS`] steps of
-    /// travel when the swarm is sparse enough that such fat AABBs rarely overlap (agents are
-    /// held in D(t), so the density is agents / (l × height)), else [`DENSE_SKIN`].
+    /// travel when the swarm is sparse enough that such fat AABBs rarely overlap, else
+    /// [`DENSE_SKIN`]. The rule still counts the sensor ball that rode on each body until
+    /// the forty-sixth session (two colliders per agent, the larger radius): the skin shapes
+    /// Rapier's tolerances and so the trajectories, which stay as they were.
     pub(crate) fn broad_phase_skin(world: &World, dt: f64) -> f64 {
-        let sparse = SPARSE_SKIN_STEPS * world.swarm.speed * dt;
-        let area = world.leader.window.min(world.arena.width) * world.arena.height;
-        let density = world.swarm.agents as f64 / area;
         let radius = world
             .swarm
             .body_radius
             .max(world.swarm.detection_radius / 2.0);
-        let side = 2.0 * (sparse + radius);
-        // Two colliders (solid and sensor) per agent.
-        let neighbours = 2.0 * density * side * side;
-        if sparse > DENSE_SKIN && neighbours <= SPARSE_MAX_NEIGHBOURS {
-            sparse
-        } else {
-            DENSE_SKIN
-        }
+        skin_for(world, dt, 2.0, radius, SPARSE_MAX_NEIGHBOURS)
     }
 
     /// Gap below which Rapier reports a contact pair (and creates speculative contacts),
