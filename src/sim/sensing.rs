@@ -26,6 +26,10 @@ use std::time::Instant;
 
 type P = (f64, f64);
 
+/// Configurations of consecutive steps: the first one's step, their number, and their
+/// positions one after another.
+type Batch = (u64, usize, Vec<P>);
+
 /// Positions per batch sent to the detector's thread (at least one configuration).
 const BATCH_POSITIONS: usize = 4096;
 /// Batches that may wait for the detector before the loop waits for it: bounds the memory
@@ -154,15 +158,16 @@ pub(crate) struct Sensing {
     agents: usize,
     /// Configurations per batch.
     per_batch: usize,
-    /// Step of the batch's first configuration, and the batch.
+    /// Step of the batch's first configuration, how many it holds, and their positions.
     first: u64,
+    configs: usize,
     batch: Vec<P>,
     mode: Mode,
 }
 
 enum Mode {
     Thread {
-        to_detector: SyncSender<(u64, Vec<P>)>,
+        to_detector: SyncSender<Batch>,
         settled: Receiver<Settled>,
         detector: JoinHandle<Option<Detected>>,
     },
@@ -173,10 +178,9 @@ enum Mode {
 }
 
 impl Sensing {
-    /// Starts `detector` for a swarm of `agents`.
+    /// Starts `detector` for a swarm of `agents` on a thread of its own.
     pub(crate) fn start(detector: Detector, agents: usize) -> Self {
-        let per_batch = (BATCH_POSITIONS / agents.max(1)).max(1);
-        let (to_detector, batches) = mpsc::sync_channel::<(u64, Vec<P>)>(QUEUED_BATCHES);
+        let (to_detector, batches) = mpsc::sync_channel::<Batch>(QUEUED_BATCHES);
         let (settle, settled) = mpsc::channel();
         // The detector is handed over once the thread has started; where none can be
         // started it stays on this thread.
@@ -186,8 +190,9 @@ impl Sensing {
             .spawn(move || {
                 let mut detector = take.recv().ok()?;
                 let mut out = Vec::new();
-                for (first, batch) in batches {
-                    for (j, pos) in batch.chunks_exact(agents.max(1)).enumerate() {
+                for (first, configs, batch) in batches {
+                    for j in 0..configs {
+                        let pos = &batch[j * agents..(j + 1) * agents];
                         detector.observe(first + j as u64, pos, &mut out);
                         for s in out.drain(..) {
                             // The loop stops listening only once it has all it needs.
@@ -197,25 +202,40 @@ impl Sensing {
                 }
                 Some(detector.finish())
             });
-        let inline = |detector| Mode::Inline {
-            detector: Box::new(detector),
-            settled: Vec::new(),
-        };
-        let mode = match spawned {
+        match spawned {
             Ok(handle) => match hand.send(detector) {
-                Ok(()) => Mode::Thread {
-                    to_detector,
-                    settled,
-                    detector: handle,
-                },
-                Err(mpsc::SendError(detector)) => inline(detector),
+                Ok(()) => Self::with_mode(
+                    agents,
+                    Mode::Thread {
+                        to_detector,
+                        settled,
+                        detector: handle,
+                    },
+                ),
+                Err(mpsc::SendError(detector)) => Self::inline(detector, agents),
             },
-            Err(_) => inline(detector),
-        };
+            Err(_) => Self::inline(detector, agents),
+        }
+    }
+
+    /// Runs `detector` on the loop's thread, as each batch is complete.
+    fn inline(detector: Detector, agents: usize) -> Self {
+        Self::with_mode(
+            agents,
+            Mode::Inline {
+                detector: Box::new(detector),
+                settled: Vec::new(),
+            },
+        )
+    }
+
+    fn with_mode(agents: usize, mode: Mode) -> Self {
+        let per_batch = (BATCH_POSITIONS / agents.max(1)).max(1);
         Self {
             agents,
             per_batch,
             first: 0,
+            configs: 0,
             batch: Vec::with_capacity(per_batch * agents),
             mode,
         }
@@ -224,19 +244,21 @@ impl Sensing {
     /// Hands over the configuration of step `k` (steps come in order, from 0); `last` marks
     /// the final one.
     pub(crate) fn push(&mut self, k: u64, pos: &[P], last: bool) {
-        if self.batch.is_empty() {
+        if self.configs == 0 {
             self.first = k;
         }
         self.batch.extend_from_slice(pos);
-        if last || self.batch.len() >= self.per_batch * self.agents {
+        self.configs += 1;
+        if last || self.configs >= self.per_batch {
             self.flush();
         }
     }
 
     fn flush(&mut self) {
-        if self.batch.is_empty() {
+        if self.configs == 0 {
             return;
         }
+        let configs = std::mem::take(&mut self.configs);
         match &mut self.mode {
             Mode::Thread { to_detector, .. } => {
                 let batch = std::mem::replace(
@@ -244,10 +266,11 @@ impl Sensing {
                     Vec::with_capacity(self.per_batch * self.agents),
                 );
                 // A detector that stopped (it panicked) is reported by `finish`.
-                let _ = to_detector.send((self.first, batch));
+                let _ = to_detector.send((self.first, configs, batch));
             }
             Mode::Inline { detector, settled } => {
-                for (j, pos) in self.batch.chunks_exact(self.agents.max(1)).enumerate() {
+                for j in 0..configs {
+                    let pos = &self.batch[j * self.agents..(j + 1) * self.agents];
                     detector.observe(self.first + j as u64, pos, settled);
                 }
                 self.batch.clear();
@@ -453,7 +476,7 @@ mod tests {
     }
 
     #[test]
-    fn the_thread_finds_what_the_loops_own_detector_finds() {
+    fn the_thread_and_the_inline_detector_find_what_a_bare_detector_finds() {
         let (n, steps) = (40, 300);
         let configs = walk(n, steps, 13);
         let cuts = [20.0, 50.0];
@@ -471,20 +494,21 @@ mod tests {
             direct.observe(k as u64, pos, &mut settled);
         }
         let direct = direct.finish();
-        let mut sensing = Sensing::start(make(), n);
-        let mut threaded = Vec::new();
-        for (k, pos) in configs.iter().enumerate() {
-            sensing.push(k as u64, pos, k == steps);
-            threaded.extend(sensing.settled());
-        }
-        let (detected, late) = sensing.finish();
-        threaded.extend(late);
-        assert_eq!(detected.encounters, direct.encounters);
-        assert_eq!(found(&detected), found(&direct));
         let key = |s: &Settled| (s.cut, s.step, s.encounters.clone());
-        assert_eq!(
-            threaded.iter().map(key).collect::<Vec<_>>(),
-            settled.iter().map(key).collect::<Vec<_>>()
-        );
+        for mut sensing in [Sensing::start(make(), n), Sensing::inline(make(), n)] {
+            let mut heard = Vec::new();
+            for (k, pos) in configs.iter().enumerate() {
+                sensing.push(k as u64, pos, k == steps);
+                heard.extend(sensing.settled());
+            }
+            let (detected, late) = sensing.finish();
+            heard.extend(late);
+            assert_eq!(detected.encounters, direct.encounters);
+            assert_eq!(found(&detected), found(&direct));
+            assert_eq!(
+                heard.iter().map(key).collect::<Vec<_>>(),
+                settled.iter().map(key).collect::<Vec<_>>()
+            );
+        }
     }
 }
