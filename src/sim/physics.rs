@@ -181,6 +181,64 @@ impl EventHandler for Collector {
     fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
 }
 
+/// One Rapier world: its sets, pipeline and event collector.
+struct Rapier {
+    params: IntegrationParameters,
+    pipeline: PhysicsPipeline,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    collector: Collector,
+}
+
+impl Rapier {
+    fn new(params: IntegrationParameters, bodies: RigidBodySet, colliders: ColliderSet) -> Self {
+        Self {
+            params,
+            pipeline: PhysicsPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: BroadPhaseBvh::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies,
+            colliders,
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::new(),
+            ccd: CCDSolver::new(),
+            collector: Collector::default(),
+        }
+    }
+
+    /// One pipeline step of `params.dt` seconds; appends its events to `out`, sorted.
+    fn step(&mut self, out: &mut Vec<RawEvent>) {
+        self.pipeline.step(
+            Vector::ZERO,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &self.collector,
+        );
+        if let Ok(mut events) = self.collector.events.lock() {
+            events.sort_unstable();
+            out.append(&mut events);
+        }
+    }
+}
+
 /// A broad-phase skin for `world` at step `dt`, metres: [`SPARSE_SKIN_STEPS`] steps of
 /// travel when a fat AABB of that skin round a ball of `radius` is expected to overlap at
 /// most `max_neighbours` others (`per_agent` colliders per agent; agents are held in D(t),
@@ -208,18 +266,7 @@ fn skin_for(world: &World, dt: f64, per_agent: f64, radius: f64, max_neighbours:
 /// with bit-identical trajectories (the solid contacts, the solver's order and every
 /// tolerance are unchanged; docs/speed.md, "Forty-sixth session").
 pub(crate) struct SensorWorld {
-    params: IntegrationParameters,
-    pipeline: PhysicsPipeline,
-    islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
-    impulse_joints: ImpulseJointSet,
-    multibody_joints: MultibodyJointSet,
-    soft_bodies: SoftBodySet,
-    ccd: CCDSolver,
-    collector: Collector,
+    rapier: Rapier,
     /// Where each ball is now; only the balls that moved are set again.
     at: Vec<Vector>,
     /// Each ball's handle, in agent order.
@@ -257,18 +304,7 @@ impl SensorWorld {
             })
             .collect();
         Self {
-            params,
-            pipeline: PhysicsPipeline::new(),
-            islands: IslandManager::new(),
-            broad_phase: BroadPhaseBvh::new(),
-            narrow_phase: NarrowPhase::new(),
-            bodies: RigidBodySet::new(),
-            colliders,
-            impulse_joints: ImpulseJointSet::new(),
-            multibody_joints: MultibodyJointSet::new(),
-            soft_bodies: SoftBodySet::new(),
-            ccd: CCDSolver::new(),
-            collector: Collector::default(),
+            rapier: Rapier::new(params, RigidBodySet::new(), colliders),
             at,
             balls,
         }
@@ -282,47 +318,19 @@ impl SensorWorld {
             let p = v(p.0, p.1);
             if *at != p {
                 *at = p;
-                if let Some(ball) = self.colliders.get_mut(h) {
+                if let Some(ball) = self.rapier.colliders.get_mut(h) {
                     ball.set_translation(p);
                 }
             }
         }
-        self.pipeline.step(
-            Vector::ZERO,
-            &self.params,
-            &mut self.islands,
-            &mut self.broad_phase,
-            &mut self.narrow_phase,
-            &mut self.bodies,
-            &mut self.colliders,
-            &mut self.impulse_joints,
-            &mut self.multibody_joints,
-            &mut self.soft_bodies,
-            &mut self.ccd,
-            &(),
-            &self.collector,
-        );
-        if let Ok(mut events) = self.collector.events.lock() {
-            events.sort_unstable();
-            out.append(&mut events);
-        }
+        self.rapier.step(out);
     }
 }
 
-/// The Rapier state of a run.
+/// The physics world of a run: the agents' bodies (agent `i` is `agents[i]`), their solid
+/// balls, and the obstacles.
 pub(crate) struct Scene {
-    params: IntegrationParameters,
-    pipeline: PhysicsPipeline,
-    islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
-    impulse_joints: ImpulseJointSet,
-    multibody_joints: MultibodyJointSet,
-    soft_bodies: SoftBodySet,
-    ccd: CCDSolver,
-    collector: Collector,
+    rapier: Rapier,
     agents: Vec<RigidBodyHandle>,
 }
 
@@ -463,18 +471,7 @@ impl Scene {
             agents.push(handle);
         }
         Self {
-            params,
-            pipeline: PhysicsPipeline::new(),
-            islands: IslandManager::new(),
-            broad_phase: BroadPhaseBvh::new(),
-            narrow_phase: NarrowPhase::new(),
-            bodies,
-            colliders,
-            impulse_joints: ImpulseJointSet::new(),
-            multibody_joints: MultibodyJointSet::new(),
-            soft_bodies: SoftBodySet::new(),
-            ccd: CCDSolver::new(),
-            collector: Collector::default(),
+            rapier: Rapier::new(params, bodies, colliders),
             agents,
         }
     }
@@ -503,7 +500,7 @@ impl Scene {
     pub(crate) fn read_positions(&self, out: &mut [(f64, f64)]) -> Option<usize> {
         let mut bad = None;
         for (i, (slot, &h)) in out.iter_mut().zip(&self.agents).enumerate() {
-            let t = self.bodies[h].translation();
+            let t = self.rapier.bodies[h].translation();
             if bad.is_none() && !(t.x.is_finite() && t.y.is_finite()) {
                 bad = Some(i);
             }
@@ -519,13 +516,13 @@ impl Scene {
         // `IndexMut` on the body set flags the body as modified by the user, which costs it
         // a pass of Rapier's change tracking (islands, colliders, NaN checks) in the next
         // step: look first, and borrow mutably only to change something.
-        let body = &self.bodies[handle];
+        let body = &self.rapier.bodies[handle];
         let locked = body.is_translation_locked();
         match vel {
             Some((vx, vy)) => {
                 let target = v(vx, vy);
                 if locked || body.linvel() != target {
-                    let body = &mut self.bodies[handle];
+                    let body = &mut self.rapier.bodies[handle];
                     if locked {
                         body.lock_translations(false, true);
                     }
@@ -534,7 +531,7 @@ impl Scene {
             }
             None => {
                 if !locked {
-                    let body = &mut self.bodies[handle];
+                    let body = &mut self.rapier.bodies[handle];
                     body.lock_translations(true, true);
                     body.set_linvel(Vector::ZERO, true);
                 }
@@ -545,25 +542,7 @@ impl Scene {
     /// Advances by `dt` seconds (`0` only runs collision detection) and appends the events
     /// seen at the configuration before the step to `out`, in a deterministic order.
     pub(crate) fn step(&mut self, dt: f64, out: &mut Vec<RawEvent>) {
-        self.params.dt = dt as f32;
-        self.pipeline.step(
-            Vector::ZERO,
-            &self.params,
-            &mut self.islands,
-            &mut self.broad_phase,
-            &mut self.narrow_phase,
-            &mut self.bodies,
-            &mut self.colliders,
-            &mut self.impulse_joints,
-            &mut self.multibody_joints,
-            &mut self.soft_bodies,
-            &mut self.ccd,
-            &(),
-            &self.collector,
-        );
-        if let Ok(mut events) = self.collector.events.lock() {
-            events.sort_unstable();
-            out.append(&mut events);
-        }
+        self.rapier.params.dt = dt as f32;
+        self.rapier.step(out);
     }
 }
