@@ -32,9 +32,11 @@ type Batch = (u64, usize, Vec<P>);
 
 /// Positions per batch sent to the detector's thread (at least one configuration).
 const BATCH_POSITIONS: usize = 4096;
-/// Batches that may wait for the detector before the loop waits for it: bounds the memory
-/// (64 × 4 096 positions, 4 MiB) and how far the detector can fall behind.
-const QUEUED_BATCHES: usize = 64;
+/// Positions that may wait for the detector before the loop waits for it (at least one
+/// batch): bounds the memory (4 MiB of queued batches below 4 096 agents; one batch of one
+/// configuration, 16 bytes an agent, above) and how far the detector can fall behind
+/// (64 batches of 4 096 / n configurations for n agents).
+const QUEUED_POSITIONS: usize = 64 * BATCH_POSITIONS;
 
 /// An encounter still running: its start time and both agents' positions then (the
 /// encounter's `truth`).
@@ -180,7 +182,9 @@ enum Mode {
 impl Sensing {
     /// Starts `detector` for a swarm of `agents` on a thread of its own.
     pub(crate) fn start(detector: Detector, agents: usize) -> Self {
-        let (to_detector, batches) = mpsc::sync_channel::<Batch>(QUEUED_BATCHES);
+        let batch = Self::per_batch(agents) * agents;
+        let queued = (QUEUED_POSITIONS / batch.max(1)).max(1);
+        let (to_detector, batches) = mpsc::sync_channel::<Batch>(queued);
         let (settle, settled) = mpsc::channel();
         // The detector is handed over once the thread has started; where none can be
         // started it stays on this thread.
@@ -229,8 +233,13 @@ impl Sensing {
         )
     }
 
+    /// Configurations per batch for a swarm of `agents`.
+    fn per_batch(agents: usize) -> usize {
+        (BATCH_POSITIONS / agents.max(1)).max(1)
+    }
+
     fn with_mode(agents: usize, mode: Mode) -> Self {
-        let per_batch = (BATCH_POSITIONS / agents.max(1)).max(1);
+        let per_batch = Self::per_batch(agents);
         Self {
             agents,
             per_batch,
