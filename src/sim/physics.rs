@@ -63,7 +63,8 @@ const SPARSE_MAX_NEIGHBOURS: f64 = 0.3;
 /// intersection test. Sensing time, skins 1 / 2 / 4 / 7.7 cm: scenario 2 (200 agents,
 /// r_d = 10 cm, 0.43 expected neighbours at 7.7 cm) 5.4 / 5.5 / 4.2 / 4.0 s; `k1.ron` (1 000
 /// agents, r_d = 1 cm, 0.90) 0.32 / 0.31 / 0.34 / 0.48 s; `k10.ron` (10 000, 9.0) 0.45 /
-/// 0.61 / 0.98 / 1.92 s (forty-sixth session; docs/speed.md).
+/// 0.61 / 0.98 / 1.92 s (forty-sixth session; scenario 2 the mean of two runs, the others
+/// one run each; docs/speed.md).
 const SENSING_MAX_NEIGHBOURS: f64 = 0.6;
 /// Rapier's contacts are speculative: a pair gets a contact constraint once its gap is
 /// below the prediction distance, and the solver then stops the bodies exactly at contact.
